@@ -1,0 +1,6 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Lets `python -m ima` run the command-line tool."""
+
+from ima.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,60 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The `ima` command line: parses arguments, dispatches to a subcommand, reports ImaError."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import sys
+import traceback
+from collections.abc import Sequence
+
+from ima import __version__
+from ima.commands import bench, demo, run, test
+from ima.errors import ImaError
+
+# Registration is explicit: a new subcommand is added here, never discovered by a scan.
+COMMANDS = [run, demo, test, bench]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="ima",
+        description="IMA Testbed: partitioned ARINC 653 avionics on emulated processors.",
+    )
+    parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for command in COMMANDS:
+        sub = command.add_parser(subparsers)
+        sub.set_defaults(func=command.run)
+    return parser
+
+
+def _die_by_signal(signum: int) -> None:
+    """Ends the process by `signum` so a calling shell or script sees the interruption."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    signal.signal(signum, signal.SIG_DFL)
+    os.kill(os.getpid(), signum)
+    # Only reached if the signal is blocked; fall back to the shell's convention.
+    raise SystemExit(128 + signum)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args) or 0
+    except ImaError as exc:
+        if args.debug:
+            traceback.print_exc()
+        print(f"ima: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt as exc:
+        # Not swallowed: the process still ends by the signal, only without a traceback.
+        if args.debug:
+            raise
+        print(file=sys.stderr)
+        _die_by_signal(getattr(exc, "signum", signal.SIGINT))
+        raise  # not reached

@@ -1,0 +1,37 @@
+# SPDX-License-Identifier: Apache-2.0
+"""`ima bench`: runs a benchmark and prints its measurements."""
+
+from __future__ import annotations
+
+import argparse
+
+from ima.commands.run import positive_int
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "bench",
+        help="run a benchmark (JSON with --json)",
+        description="Run a benchmark. Speed and memory targets are measured here, "
+        "never asserted in timed tests.",
+    )
+    targets = parser.add_subparsers(dest="target", metavar="TARGET", required=True)
+    ske = targets.add_parser(
+        "ske", help="separation kernel emulator: schedule speed, window switch time, jitter"
+    )
+    ske.add_argument("--json", action="store_true", help="print the results as JSON")
+    ske.add_argument(
+        "--frames",
+        type=positive_int,
+        metavar="N",
+        help="major frames per measurement (default: the benchmark's own)",
+    )
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.target == "ske":
+        from ima.bench import ske
+
+        return ske.run(frames=args.frames, json_out=args.json) or 0
+    raise AssertionError(f"unhandled bench target {args.target}")  # argparse restricts it

@@ -1,0 +1,131 @@
+# SPDX-License-Identifier: Apache-2.0
+"""`ima test`: runs the whole test suite, C tests through ctest and Python tests through pytest."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from ima import paths
+
+# pytest's documented exit codes (pytest.ExitCode), without importing pytest here.
+_PYTEST_EXIT = {
+    0: None,
+    1: "tests failed",
+    2: "interrupted",
+    3: "internal error",
+    4: "usage error",
+    5: "no tests collected — a suite that runs nothing counts as a failure",
+}
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """Result of one test runner: `ok` and, when not ok, why."""
+
+    runner: str
+    ok: bool
+    reason: str = ""
+
+    def __str__(self) -> str:
+        return f"{self.runner}: ok" if self.ok else f"{self.runner}: FAILED ({self.reason})"
+
+
+def pytest_outcome(returncode: int) -> Outcome:
+    if returncode == 0:
+        return Outcome("pytest", True)
+    if returncode < 0:
+        return Outcome("pytest", False, f"killed by signal {-returncode}")
+    return Outcome("pytest", False, _PYTEST_EXIT.get(returncode) or f"exit code {returncode}")
+
+
+def ctest_outcome(returncode: int) -> Outcome:
+    if returncode == 0:
+        return Outcome("ctest", True)
+    if returncode < 0:
+        return Outcome("ctest", False, f"killed by signal {-returncode}")
+    # ctest exits 8 when tests fail, and non-zero for "no tests" under --no-tests=error.
+    return Outcome("ctest", False, f"exit code {returncode}")
+
+
+def summary(outcomes: Sequence[Outcome]) -> tuple[str, int]:
+    """The closing line and the exit code (0 only if every runner passed)."""
+    line = ", ".join(str(o) for o in outcomes)
+    return line, 0 if all(o.ok for o in outcomes) else 1
+
+
+def ctest_command(build: Path) -> list[str]:
+    return ["ctest", "--test-dir", str(build), "--output-on-failure", "--no-tests=error", "-j2"]
+
+
+def pytest_command(
+    python: str, tests: Path, keyword: str | None, env: Mapping[str, str]
+) -> list[str]:
+    cmd = [python, "-m", "pytest", str(tests), "-q"]
+    if keyword:
+        cmd += ["-k", keyword]
+    if env.get("CI") == "true":
+        # CI runs in a fresh clone: a cache would only be litter.
+        cmd += ["-p", "no:cacheprovider"]
+    return cmd
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "test",
+        help="run the whole test suite (ctest + pytest)",
+        description="Run the C tests (ctest, in the build tree) then the Python tests "
+        "(pytest, tests/). Exits non-zero if either fails or runs no test.",
+    )
+    parser.add_argument(
+        "-k",
+        dest="keyword",
+        metavar="EXPR",
+        help="only pytest tests matching EXPR (passed to pytest -k)",
+    )
+    only = parser.add_mutually_exclusive_group()
+    only.add_argument("--unit-only", action="store_true", help="run ctest only")
+    only.add_argument("--py-only", action="store_true", help="run pytest only")
+    return parser
+
+
+def _run_ctest(root: Path, build: Path) -> Outcome:
+    if not (build / "CTestTestfile.cmake").is_file():
+        print(
+            f"ima: no CMake build tree with tests in {build} (./ima configures and builds it)",
+            file=sys.stderr,
+        )
+        return Outcome("ctest", False, "no build tree")
+    try:
+        done = subprocess.run(ctest_command(build), cwd=root)
+    except FileNotFoundError:
+        return Outcome("ctest", False, "ctest not found: install the Debian package cmake")
+    return ctest_outcome(done.returncode)
+
+
+def _run_pytest(root: Path, keyword: str | None) -> Outcome:
+    cmd = pytest_command(sys.executable, paths.tests_dir(), keyword, os.environ)
+    outcome = pytest_outcome(subprocess.run(cmd, cwd=root).returncode)
+    if not outcome.ok and outcome.reason.startswith("no tests"):
+        print(
+            f"ima: pytest collected no tests{' matching -k ' + keyword if keyword else ''}",
+            file=sys.stderr,
+        )
+    return outcome
+
+
+def run(args: argparse.Namespace) -> int:
+    root = paths.repo_root()
+    outcomes = []
+    if not args.py_only:
+        outcomes.append(_run_ctest(root, paths.build_dir()))
+    if not args.unit_only:
+        outcomes.append(_run_pytest(root, args.keyword))
+    line, code = summary(outcomes)
+    print(line)
+    return code

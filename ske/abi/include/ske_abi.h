@@ -1,0 +1,195 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The contract between the Separation Kernel Emulator and a partition's APEX library:
+ * the control block each partition shares with the SKE, and the layout of port memory. */
+#ifndef SKE_ABI_H
+#define SKE_ABI_H
+
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <time.h>
+
+#define SKE_ABI_MAGIC 0x53414d49u /* "IMAS" */
+#define SKE_ABI_VERSION 1u
+
+#define SKE_NAME_MAX 32 /* names carry at most 31 characters + NUL (ARINC allows 30) */
+#define SKE_MAX_PORTS 64 /* per partition */
+#define SKE_EVENT_RING 256 /* partition → SKE trace events per window, power of two */
+#define SKE_EVENT_TEXT 128
+
+/* Environment variable naming the control block's file descriptor in a partition. */
+#define SKE_ENV_CTL_FD "IMA_SKE_CTL_FD"
+
+typedef enum {
+    SKE_TIME_EMULATED = 0,
+    SKE_TIME_REALTIME = 1,
+} ske_time_mode_t;
+
+typedef enum {
+    SKE_PORT_SAMPLING = 1,
+    SKE_PORT_QUEUING = 2,
+} ske_port_kind_t;
+
+typedef enum {
+    SKE_DIR_SOURCE = 0, /* same values as the APEX PORT_DIRECTION_TYPE */
+    SKE_DIR_DESTINATION = 1,
+} ske_port_dir_t;
+
+/* Operating modes, same values as APEX OPERATING_MODE_TYPE. */
+enum { SKE_MODE_IDLE = 0, SKE_MODE_COLD_START = 1, SKE_MODE_WARM_START = 2, SKE_MODE_NORMAL = 3 };
+
+/* Partition → SKE trace events. The SKE validates every field: the ring lives in memory the
+ * partition can write, so its content is untrusted. */
+typedef enum {
+    SKE_EV_MODE = 1, /* a = new mode, b = previous mode */
+    SKE_EV_PORT_VALIDITY = 2, /* a = port index, b = new validity (0 invalid, 1 valid) */
+    SKE_EV_APP_MESSAGE = 3, /* a = process id (0 = initialisation), text = message */
+    SKE_EV_PROCESS = 4, /* a = process id, b = ske_proc_event_t, text = process name */
+} ske_event_kind_t;
+
+typedef enum {
+    SKE_PROC_EV_START = 1,
+    SKE_PROC_EV_STOP = 2,
+} ske_proc_event_t;
+
+typedef struct {
+    int64_t t_ns;
+    uint32_t kind;
+    int32_t a;
+    int32_t b;
+    uint32_t len; /* bytes used in text */
+    char text[SKE_EVENT_TEXT];
+} ske_event_t;
+
+/* One of the partition's own ports. The SKE fills it before exec; `fd` is the partition's
+ * descriptor of the port memory (read-only for destination ports). */
+typedef struct {
+    char name[SKE_NAME_MAX];
+    uint32_t kind; /* ske_port_kind_t */
+    uint32_t dir; /* ske_port_dir_t */
+    uint32_t max_size; /* bytes */
+    uint32_t max_nb; /* queuing: capacity of this port's queue */
+    int64_t refresh_ns; /* sampling: refresh period */
+    int32_t fd;
+    uint32_t map_size; /* bytes to map */
+    uint32_t channel; /* channel identifier, 0 if unconnected */
+    /* Destination queuing ports: the consumer side of the queue, written by the partition. */
+    _Atomic uint32_t rx_tail;
+    _Atomic uint32_t overflow_ack;
+} ske_port_desc_t;
+
+/* The control block. Written by the SKE before exec (identity, schedule, ports) and then
+ * used for the grant/yield hand-over:
+ *   SKE grants:        win_start/win_end set, then ++grant_seq and a futex wake.
+ *   partition yields:  yield_seq = grant_seq it observed, then a futex wake; it then waits
+ *                      for grant_seq to change.
+ * Everything the partition writes is untrusted by the SKE. */
+typedef struct {
+    uint32_t magic;
+    uint32_t version;
+    int32_t partition_id;
+    char partition_name[SKE_NAME_MAX];
+    char node[SKE_NAME_MAX];
+    uint32_t time_mode; /* ske_time_mode_t */
+    uint32_t system_partition;
+    int64_t epoch_mono_ns; /* real-time mode: CLOCK_MONOTONIC of module time 0 */
+    int64_t period_ns; /* partition period */
+    int64_t duration_ns; /* window time per partition period */
+    int64_t period_anchor_ns; /* offset in the major frame where a partition period starts */
+    int64_t major_frame_ns;
+    uint32_t start_condition; /* APEX START_CONDITION_TYPE */
+    uint32_t initial_mode; /* COLD_START or WARM_START */
+    uint32_t n_ports;
+    uint32_t pad0;
+    ske_port_desc_t ports[SKE_MAX_PORTS];
+
+    /* Hand-over. */
+    _Atomic uint32_t grant_seq;
+    _Atomic uint32_t yield_seq;
+    _Atomic uint32_t ready; /* partition set it once attached and waiting for its first grant */
+    _Atomic uint32_t stop_request; /* SKE asks the partition to exit at its next grant */
+    _Atomic int64_t win_start_ns; /* current window, partition time */
+    _Atomic int64_t win_end_ns;
+
+    /* Partition → SKE, informational or requests. */
+    _Atomic int64_t wake_mono_ns; /* CLOCK_MONOTONIC when the partition saw its grant */
+    _Atomic int64_t yield_mono_ns; /* CLOCK_MONOTONIC when it yielded */
+    _Atomic int64_t yield_t_ns; /* partition time when it yielded */
+    _Atomic uint32_t mode; /* current operating mode as the partition reports it */
+    _Atomic uint32_t mode_request; /* IDLE/COLD_START/WARM_START asked by SET_PARTITION_MODE */
+    _Atomic uint32_t mode_request_seq;
+
+    _Atomic uint32_t ev_head; /* written by the partition */
+    _Atomic uint32_t ev_tail; /* written by the SKE */
+    _Atomic uint32_t ev_dropped; /* events lost because the ring was full */
+    uint32_t pad1;
+    ske_event_t ev[SKE_EVENT_RING];
+} ske_ctl_t;
+
+/* ---- Port memory ---------------------------------------------------------------------- */
+
+/* Sampling channel: one memory object per channel, the source maps it writable and every
+ * destination read-only. Two slots: the writer fills the slot the readers do not see, then
+ * publishes it by incrementing seq, so a reader never sees a half-written message even if
+ * the writer was stopped in the middle of a write. */
+typedef struct {
+    uint32_t magic;
+    uint32_t max_size;
+    _Atomic uint32_t seq; /* number of messages written; 0 = empty; slot (seq & 1) is latest */
+    uint32_t pad;
+} ske_sampling_hdr_t;
+
+typedef struct {
+    int64_t t_ns; /* partition time of the write */
+    uint32_t len;
+    uint32_t seq;
+    /* uint8_t data[slot payload] */
+} ske_slot_hdr_t;
+
+/* Queue: a single-producer single-consumer ring of `capacity` slots. A source queuing
+ * port's queue is produced by the source partition and consumed by the SKE (transfer at
+ * the end of the source's window); a destination port's queue is produced by the SKE and
+ * consumed by the destination partition, whose tail lives in its port descriptor so that
+ * the queue memory itself stays read-only for it. */
+typedef struct {
+    uint32_t magic;
+    uint32_t max_size;
+    uint32_t capacity;
+    _Atomic uint32_t head; /* messages produced (wraps) */
+    _Atomic uint32_t tail; /* source queues: messages consumed by the SKE */
+    _Atomic uint32_t overflows; /* destination queues: messages lost to overflow (SKE) */
+    uint32_t pad[2];
+} ske_queue_hdr_t;
+
+/* Sizes and slot addressing shared by both sides. */
+size_t ske_slot_stride(uint32_t max_size);
+size_t ske_sampling_map_size(uint32_t max_size);
+size_t ske_queue_map_size(uint32_t max_size, uint32_t capacity);
+
+void ske_sampling_init(void *mem, uint32_t max_size);
+/* Writes a message (len ≤ max_size checked by the caller). */
+void ske_sampling_write(void *mem, uint32_t max_size, const void *msg, uint32_t len, int64_t t_ns);
+/* Copies the latest message; returns false when none was ever written. *len is clamped to
+ * max_size so that a corrupted header cannot make the reader overrun its buffer. */
+bool ske_sampling_read(const void *mem, uint32_t max_size, void *msg, uint32_t *len,
+                       int64_t *t_ns);
+
+void ske_queue_init(void *mem, uint32_t max_size, uint32_t capacity);
+/* Number of messages between tail and head, or UINT32_MAX if the indices are inconsistent. */
+uint32_t ske_queue_count(const void *mem, uint32_t capacity, uint32_t tail);
+/* Producer side. Returns false when full. */
+bool ske_queue_push(void *mem, uint32_t max_size, uint32_t capacity, uint32_t tail,
+                    const void *msg, uint32_t len, int64_t t_ns);
+/* Consumer side: copy the message at `tail` (the caller then advances its tail). */
+void ske_queue_peek(const void *mem, uint32_t max_size, uint32_t capacity, uint32_t tail,
+                    void *msg, uint32_t *len, int64_t *t_ns);
+
+/* ---- Hand-over helpers ---------------------------------------------------------------- */
+
+int64_t ske_mono_ns(void);
+/* Shared (not process-private) futex on a word of the control block. rel may be NULL. */
+int ske_futex_wait(_Atomic uint32_t *word, uint32_t expected, const struct timespec *rel);
+int ske_futex_wake(_Atomic uint32_t *word);
+
+#endif /* SKE_ABI_H */

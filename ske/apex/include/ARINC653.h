@@ -1,0 +1,14 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The whole ARINC 653 APEX C binding provided by the IMA Testbed: include this one. */
+#ifndef ARINC653_H
+#define ARINC653_H
+
+#include "apex_types.h"
+#include "apex_time.h"
+#include "apex_process.h"
+#include "apex_partition.h"
+#include "apex_sampling.h"
+#include "apex_queuing.h"
+#include "apex_error.h"
+
+#endif /* ARINC653_H */

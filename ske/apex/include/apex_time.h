@@ -1,0 +1,19 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* ARINC 653 Part 1 time management services, C binding. */
+#ifndef APEX_TIME
+#define APEX_TIME
+
+#include "apex_types.h"
+
+extern void TIMED_WAIT(
+    /*in */ SYSTEM_TIME_TYPE DELAY_TIME,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+extern void PERIODIC_WAIT(
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+extern void GET_TIME(
+    /*out*/ SYSTEM_TIME_TYPE *SYSTEM_TIME,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+#endif /* APEX_TIME */

@@ -1,0 +1,104 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The APEX run-time inside one partition: its view of the control block, its ARINC
+ * processes and their deterministic scheduler. Private to the APEX library. */
+#ifndef APEX__RT_H
+#define APEX__RT_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <ucontext.h>
+
+#include "ARINC653.h"
+#include "ske_abi.h"
+
+typedef enum {
+    WAIT_NONE,
+    WAIT_DELAY, /* TIMED_WAIT */
+    WAIT_PERIOD, /* PERIODIC_WAIT, or a periodic process waiting for its first release */
+    WAIT_QRECV, /* RECEIVE_QUEUING_MESSAGE on an empty queue */
+    WAIT_QSEND, /* SEND_QUEUING_MESSAGE on a full queue */
+} apex_wait_t;
+
+typedef struct {
+    PROCESS_ATTRIBUTE_TYPE attr;
+    PROCESS_ID_TYPE id;
+    PROCESS_STATE_TYPE state;
+    PRIORITY_TYPE cur_prio;
+    SYSTEM_TIME_TYPE deadline_time;
+    int64_t next_release; /* periodic: the next release point */
+    int64_t wake_at; /* INT64_MAX: no time-out */
+    apex_wait_t wait;
+    int wait_port; /* port index for queuing waits */
+    uint64_t wait_order; /* FIFO order among processes waiting on the same port */
+    RETURN_CODE_TYPE wait_rc;
+    uint64_t ready_order; /* FIFO order within a priority */
+    bool start_pending; /* START called before NORMAL mode */
+    /* Queuing wait arguments. */
+    const APEX_BYTE *q_msg;
+    MESSAGE_SIZE_TYPE q_len;
+    APEX_BYTE *q_buf;
+    MESSAGE_SIZE_TYPE *q_len_out;
+    ucontext_t ctx;
+    void *stack_map;
+    size_t stack_map_size;
+} apex_proc_t;
+
+typedef struct {
+    bool created;
+    void *mem;
+    size_t map_size;
+    QUEUING_DISCIPLINE_TYPE discipline;
+    VALIDITY_TYPE last_validity;
+    bool validity_known;
+} apex_port_t;
+
+typedef struct {
+    ske_ctl_t *ctl;
+    bool realtime;
+    uint32_t seen_grant;
+    int64_t now; /* partition time, ns */
+    int64_t win_start, win_end;
+    OPERATING_MODE_TYPE mode;
+    int n_procs;
+    apex_proc_t procs[MAX_NUMBER_OF_PROCESSES];
+    apex_proc_t *current; /* NULL while the initialisation (main) process runs */
+    ucontext_t sched_ctx;
+    uint64_t order;
+    apex_port_t ports[SKE_MAX_PORTS];
+} apex_rt_t;
+
+/* The partition's one run-time: the APEX interface has no context argument. */
+extern apex_rt_t apex__rt;
+
+/* Brings the partition's view of time and window up to date; called at every service. */
+void apex__sync(void);
+/* Partition time now. */
+int64_t apex__now(void);
+/* Sends a trace event to the SKE. */
+void apex__event(uint32_t kind, int32_t a, int32_t b, const void *text, uint32_t len);
+/* Blocks the current process (its wait fields set by the caller) until the scheduler makes
+ * it ready again; returns its wait result. */
+RETURN_CODE_TYPE apex__block(apex_proc_t *p);
+/* Lets a higher-priority ready process run now (preemption at a service call). */
+void apex__preempt_check(void);
+/* Marks a process ready, at the back of its priority's FIFO. */
+void apex__make_ready(apex_proc_t *p);
+/* Enters NORMAL mode from the initialisation process: never returns. */
+void apex__enter_normal(void) __attribute__((noreturn));
+/* Hands the CPU back to the SKE until the next window. */
+void apex__yield_cpu(void);
+/* The first partition period start at or after t. */
+int64_t apex__next_period_start(int64_t t);
+/* Index of a created port of the given kind from an APEX identifier, or -1. */
+int apex__port_index(APEX_INTEGER id, uint32_t kind);
+/* Index of a configured port by APEX name (NAME_TYPE need not be NUL-terminated). */
+int apex__port_by_name(const char *name, uint32_t kind);
+/* Maps configured port k (read-only for destinations); false if it cannot be mapped. */
+bool apex__port_map(int k);
+/* Completes port waits whose condition now holds (scheduler side). */
+void apex__service_port_waiters(void);
+/* Messages waiting in a queuing port, and whether any process waits on it. */
+uint32_t apex__queue_count(int k);
+int apex__queue_waiters(int k);
+
+#endif /* APEX__RT_H */

@@ -1,0 +1,19 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* APEX health monitoring services available so far: REPORT_APPLICATION_MESSAGE
+ * (ARINC 653 Part 1, 3.10.2). */
+#include "apex__rt.h"
+
+void REPORT_APPLICATION_MESSAGE(
+    /*in */ MESSAGE_ADDR_TYPE MESSAGE_ADDR,
+    /*in */ MESSAGE_SIZE_TYPE LENGTH,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
+{
+    apex__sync();
+    if (LENGTH < 0 || LENGTH > MAX_ERROR_MESSAGE_SIZE || (LENGTH > 0 && !MESSAGE_ADDR)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    PROCESS_ID_TYPE id = apex__rt.current ? apex__rt.current->id : 0;
+    apex__event(SKE_EV_APP_MESSAGE, id, 0, MESSAGE_ADDR, (uint32_t)LENGTH);
+    *RETURN_CODE = NO_ERROR;
+}

@@ -1,0 +1,315 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The APEX run-time of a partition: attaches to the SKE before main() runs, schedules the
+ * partition's ARINC processes one at a time, and hands the CPU back when all of them wait. */
+#include "apex__rt.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <time.h>
+#include <unistd.h>
+
+apex_rt_t apex__rt;
+
+static void fatal(const char *msg)
+{
+    fprintf(stderr, "%s\n", msg);
+    _exit(2);
+}
+
+/* ---- hand-over with the SKE ----------------------------------------------------------- */
+
+static void take_grant(void)
+{
+    apex_rt_t *rt = &apex__rt;
+    ske_ctl_t *c = rt->ctl;
+    rt->seen_grant = atomic_load_explicit(&c->grant_seq, memory_order_acquire);
+    atomic_store(&c->wake_mono_ns, ske_mono_ns());
+    rt->win_start = atomic_load(&c->win_start_ns);
+    rt->win_end = atomic_load(&c->win_end_ns);
+    if (!rt->realtime && rt->now < rt->win_start)
+        rt->now = rt->win_start;
+    if (atomic_load(&c->stop_request))
+        _exit(0);
+}
+
+static void wait_grant(void)
+{
+    ske_ctl_t *c = apex__rt.ctl;
+    uint32_t seen = apex__rt.seen_grant;
+    while (atomic_load_explicit(&c->grant_seq, memory_order_acquire) == seen)
+        ske_futex_wait(&c->grant_seq, seen, NULL);
+    take_grant();
+}
+
+void apex__yield_cpu(void)
+{
+    apex_rt_t *rt = &apex__rt;
+    ske_ctl_t *c = rt->ctl;
+    /* Yield for the window we hold now, even if we were stopped and continued into a later
+     * one after an overrun. */
+    uint32_t g = atomic_load_explicit(&c->grant_seq, memory_order_acquire);
+    if (g != rt->seen_grant)
+        take_grant();
+    atomic_store(&c->yield_t_ns, apex__now());
+    atomic_store(&c->yield_mono_ns, ske_mono_ns());
+    atomic_store_explicit(&c->yield_seq, rt->seen_grant, memory_order_release);
+    ske_futex_wake(&c->yield_seq);
+    wait_grant();
+}
+
+/* Runs before main(): the partition's initialisation process starts inside its first
+ * window, never before. */
+__attribute__((constructor)) static void apex_attach(void)
+{
+    const char *s = getenv(SKE_ENV_CTL_FD);
+    if (!s)
+        fatal("this program is an ARINC 653 partition: run it under ima-ske "
+              "(for example: ./ima run MODULE.xml)");
+    char *end;
+    long fd = strtol(s, &end, 10);
+    if (*end || fd < 0)
+        fatal("apex: bad " SKE_ENV_CTL_FD);
+    void *m = mmap(NULL, sizeof(ske_ctl_t), PROT_READ | PROT_WRITE, MAP_SHARED, (int)fd, 0);
+    if (m == MAP_FAILED)
+        fatal("apex: cannot map the SKE control block");
+    close((int)fd);
+    unsetenv(SKE_ENV_CTL_FD);
+    apex_rt_t *rt = &apex__rt;
+    rt->ctl = m;
+    if (rt->ctl->magic != SKE_ABI_MAGIC || rt->ctl->version != SKE_ABI_VERSION)
+        fatal("apex: the SKE speaks another version of the partition interface");
+    rt->realtime = rt->ctl->time_mode == SKE_TIME_REALTIME;
+    rt->mode = (OPERATING_MODE_TYPE)rt->ctl->initial_mode;
+    rt->seen_grant = 0;
+    atomic_store(&rt->ctl->ready, 1);
+    ske_futex_wake(&rt->ctl->ready);
+    wait_grant();
+    if (rt->realtime)
+        rt->now = ske_mono_ns() - rt->ctl->epoch_mono_ns;
+}
+
+/* ---- time ----------------------------------------------------------------------------- */
+
+int64_t apex__now(void)
+{
+    apex_rt_t *rt = &apex__rt;
+    if (rt->realtime)
+        rt->now = ske_mono_ns() - rt->ctl->epoch_mono_ns;
+    return rt->now;
+}
+
+static void release_due(void);
+
+void apex__sync(void)
+{
+    apex_rt_t *rt = &apex__rt;
+    if (atomic_load_explicit(&rt->ctl->grant_seq, memory_order_acquire) != rt->seen_grant)
+        take_grant(); /* we were stopped after an overrun and continued in a new window */
+    if (rt->realtime) {
+        apex__now();
+        if (rt->mode == NORMAL)
+            release_due();
+    }
+}
+
+int64_t apex__next_period_start(int64_t t)
+{
+    const ske_ctl_t *c = apex__rt.ctl;
+    int64_t period = c->period_ns > 0 ? c->period_ns : c->major_frame_ns;
+    int64_t anchor = c->period_anchor_ns;
+    if (t <= anchor)
+        return anchor;
+    int64_t k = (t - anchor + period - 1) / period;
+    return anchor + k * period;
+}
+
+/* ---- events --------------------------------------------------------------------------- */
+
+void apex__event(uint32_t kind, int32_t a, int32_t b, const void *text, uint32_t len)
+{
+    ske_ctl_t *c = apex__rt.ctl;
+    uint32_t head = atomic_load_explicit(&c->ev_head, memory_order_relaxed);
+    uint32_t tail = atomic_load_explicit(&c->ev_tail, memory_order_acquire);
+    if (head - tail >= SKE_EVENT_RING) {
+        atomic_fetch_add(&c->ev_dropped, 1);
+        return;
+    }
+    ske_event_t *e = &c->ev[head % SKE_EVENT_RING];
+    e->t_ns = apex__now();
+    e->kind = kind;
+    e->a = a;
+    e->b = b;
+    if (len > SKE_EVENT_TEXT)
+        len = SKE_EVENT_TEXT;
+    e->len = len;
+    if (len)
+        memcpy(e->text, text, len);
+    atomic_store_explicit(&c->ev_head, head + 1, memory_order_release);
+}
+
+/* ---- process scheduler ---------------------------------------------------------------- */
+
+void apex__make_ready(apex_proc_t *p)
+{
+    p->state = READY;
+    p->wait = WAIT_NONE;
+    p->ready_order = ++apex__rt.order;
+}
+
+/* Highest current priority first, FIFO (time it became ready) within a priority. */
+static apex_proc_t *pick(void)
+{
+    apex_rt_t *rt = &apex__rt;
+    apex_proc_t *best = NULL;
+    for (int i = 0; i < rt->n_procs; i++) {
+        apex_proc_t *p = &rt->procs[i];
+        if (p->state != READY)
+            continue;
+        if (!best || p->cur_prio > best->cur_prio ||
+            (p->cur_prio == best->cur_prio && p->ready_order < best->ready_order))
+            best = p;
+    }
+    return best;
+}
+
+static void release(apex_proc_t *p)
+{
+    if (p->wait == WAIT_PERIOD) {
+        int64_t r = p->wake_at;
+        p->deadline_time = p->attr.TIME_CAPACITY == INFINITE_TIME_VALUE
+                               ? INFINITE_TIME_VALUE
+                               : r + p->attr.TIME_CAPACITY;
+        p->next_release = r + p->attr.PERIOD;
+        p->wait_rc = NO_ERROR;
+    } else if (p->wait == WAIT_DELAY) {
+        p->wait_rc = NO_ERROR;
+    } else {
+        p->wait_rc = TIMED_OUT; /* a queuing wait ran out; outputs stay untouched */
+    }
+    p->wake_at = INT64_MAX;
+    apex__make_ready(p);
+}
+
+/* Processes whose time has come, in time order then process order, so that the FIFO
+ * order of simultaneous releases is deterministic. */
+static void release_due(void)
+{
+    apex_rt_t *rt = &apex__rt;
+    for (;;) {
+        apex_proc_t *first = NULL;
+        for (int i = 0; i < rt->n_procs; i++) {
+            apex_proc_t *p = &rt->procs[i];
+            if (p->state == WAITING && p->wake_at <= rt->now && (!first || p->wake_at < first->wake_at))
+                first = p;
+        }
+        if (!first)
+            return;
+        release(first);
+    }
+}
+
+static int64_t next_event(void)
+{
+    apex_rt_t *rt = &apex__rt;
+    int64_t t = INT64_MAX;
+    for (int i = 0; i < rt->n_procs; i++)
+        if (rt->procs[i].state == WAITING && rt->procs[i].wake_at < t)
+            t = rt->procs[i].wake_at;
+    return t;
+}
+
+static void run(apex_proc_t *p)
+{
+    apex_rt_t *rt = &apex__rt;
+    rt->current = p;
+    p->state = RUNNING;
+    swapcontext(&rt->sched_ctx, &p->ctx);
+    rt->current = NULL;
+}
+
+static void sleep_until(int64_t t)
+{
+    int64_t abs_ns = apex__rt.ctl->epoch_mono_ns + t;
+    struct timespec ts = {abs_ns / 1000000000LL, abs_ns % 1000000000LL};
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR) {
+    }
+}
+
+/* The scheduler runs on the initialisation process's stack once the partition is NORMAL.
+ * Emulated time: computation takes no time, so time moves only here, to the next release
+ * or time-out inside the window; past the window, the CPU goes back to the SKE. */
+static void __attribute__((noreturn)) scheduler_loop(void)
+{
+    apex_rt_t *rt = &apex__rt;
+    for (;;) {
+        apex__sync();
+        release_due();
+        apex__service_port_waiters();
+        apex_proc_t *p = pick();
+        if (p) {
+            run(p);
+            continue;
+        }
+        int64_t next = next_event();
+        if (next < rt->win_end) {
+            if (rt->realtime)
+                sleep_until(next);
+            else
+                rt->now = next;
+            continue;
+        }
+        apex__yield_cpu();
+    }
+}
+
+RETURN_CODE_TYPE apex__block(apex_proc_t *p)
+{
+    p->state = WAITING;
+    swapcontext(&p->ctx, &apex__rt.sched_ctx);
+    return p->wait_rc;
+}
+
+void apex__preempt_check(void)
+{
+    apex_rt_t *rt = &apex__rt;
+    apex_proc_t *cur = rt->current;
+    if (!cur || rt->mode != NORMAL)
+        return;
+    apex_proc_t *p = pick();
+    if (p && p->cur_prio > cur->cur_prio) {
+        /* The preempted process keeps its place: it has been ready the longest. */
+        cur->state = READY;
+        swapcontext(&cur->ctx, &rt->sched_ctx);
+    }
+}
+
+void apex__enter_normal(void)
+{
+    apex_rt_t *rt = &apex__rt;
+    OPERATING_MODE_TYPE prev = rt->mode;
+    rt->mode = NORMAL;
+    atomic_store(&rt->ctl->mode, NORMAL);
+    apex__event(SKE_EV_MODE, NORMAL, prev, NULL, 0);
+    int64_t now = apex__now();
+    int64_t first_release = apex__next_period_start(now);
+    for (int i = 0; i < rt->n_procs; i++) {
+        apex_proc_t *p = &rt->procs[i];
+        if (!p->start_pending)
+            continue;
+        p->start_pending = false;
+        if (p->attr.PERIOD == INFINITE_TIME_VALUE) {
+            p->deadline_time = p->attr.TIME_CAPACITY == INFINITE_TIME_VALUE
+                                   ? INFINITE_TIME_VALUE
+                                   : now + p->attr.TIME_CAPACITY;
+            apex__make_ready(p);
+        } else {
+            p->state = WAITING;
+            p->wait = WAIT_PERIOD;
+            p->wake_at = first_release;
+        }
+    }
+    scheduler_loop();
+}

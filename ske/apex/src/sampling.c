@@ -1,0 +1,141 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* APEX sampling port services (ARINC 653 Part 1, 3.6.2.1). */
+#include "apex__rt.h"
+
+void CREATE_SAMPLING_PORT(
+    /*in */ const char *SAMPLING_PORT_NAME,
+    /*in */ MESSAGE_SIZE_TYPE MAX_MESSAGE_SIZE,
+    /*in */ PORT_DIRECTION_TYPE PORT_DIRECTION,
+    /*in */ SYSTEM_TIME_TYPE REFRESH_PERIOD,
+    /*out*/ SAMPLING_PORT_ID_TYPE *SAMPLING_PORT_ID,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
+{
+    apex__sync();
+    int k = apex__port_by_name(SAMPLING_PORT_NAME, SKE_PORT_SAMPLING);
+    if (k < 0) {
+        *RETURN_CODE = INVALID_CONFIG; /* no such port in the configuration */
+        return;
+    }
+    const ske_port_desc_t *d = &apex__rt.ctl->ports[k];
+    if (apex__rt.ports[k].created) {
+        *RETURN_CODE = NO_ACTION;
+        return;
+    }
+    if (MAX_MESSAGE_SIZE <= 0 || (uint32_t)MAX_MESSAGE_SIZE != d->max_size ||
+        (PORT_DIRECTION != SOURCE && PORT_DIRECTION != DESTINATION) ||
+        (uint32_t)PORT_DIRECTION != d->dir || REFRESH_PERIOD < 0 ||
+        REFRESH_PERIOD != d->refresh_ns) {
+        *RETURN_CODE = INVALID_CONFIG;
+        return;
+    }
+    if (apex__rt.mode == NORMAL) {
+        *RETURN_CODE = INVALID_MODE;
+        return;
+    }
+    if (!apex__port_map(k)) {
+        *RETURN_CODE = INVALID_CONFIG;
+        return;
+    }
+    *SAMPLING_PORT_ID = k + 1;
+    *RETURN_CODE = NO_ERROR;
+}
+
+void WRITE_SAMPLING_MESSAGE(
+    /*in */ SAMPLING_PORT_ID_TYPE SAMPLING_PORT_ID,
+    /*in */ MESSAGE_ADDR_TYPE MESSAGE_ADDR,
+    /*in */ MESSAGE_SIZE_TYPE LENGTH,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
+{
+    apex__sync();
+    int k = apex__port_index(SAMPLING_PORT_ID, SKE_PORT_SAMPLING);
+    if (k < 0) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    const ske_port_desc_t *d = &apex__rt.ctl->ports[k];
+    if (LENGTH > (MESSAGE_SIZE_TYPE)d->max_size) {
+        *RETURN_CODE = INVALID_CONFIG;
+        return;
+    }
+    if (LENGTH <= 0 || !MESSAGE_ADDR) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    if (d->dir != SKE_DIR_SOURCE) {
+        *RETURN_CODE = INVALID_MODE;
+        return;
+    }
+    ske_sampling_write(apex__rt.ports[k].mem, d->max_size, MESSAGE_ADDR, (uint32_t)LENGTH, apex__now());
+    *RETURN_CODE = NO_ERROR;
+}
+
+void READ_SAMPLING_MESSAGE(
+    /*in */ SAMPLING_PORT_ID_TYPE SAMPLING_PORT_ID,
+    /*out*/ MESSAGE_ADDR_TYPE MESSAGE_ADDR,
+    /*out*/ MESSAGE_SIZE_TYPE *LENGTH,
+    /*out*/ VALIDITY_TYPE *VALIDITY,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
+{
+    apex__sync();
+    int k = apex__port_index(SAMPLING_PORT_ID, SKE_PORT_SAMPLING);
+    if (k < 0 || !MESSAGE_ADDR) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    const ske_port_desc_t *d = &apex__rt.ctl->ports[k];
+    apex_port_t *ap = &apex__rt.ports[k];
+    if (d->dir != SKE_DIR_DESTINATION) {
+        *RETURN_CODE = INVALID_MODE;
+        return;
+    }
+    uint32_t len;
+    int64_t t;
+    if (!ske_sampling_read(ap->mem, d->max_size, MESSAGE_ADDR, &len, &t)) {
+        *RETURN_CODE = NO_ACTION; /* no message was ever written */
+        return;
+    }
+    /* Valid when the message's age is within the refresh period (Part 1, 2.3.5.3). */
+    int64_t age = apex__now() - t;
+    VALIDITY_TYPE v = age <= d->refresh_ns ? VALID : INVALID;
+    if (!ap->validity_known || ap->last_validity != v)
+        apex__event(SKE_EV_PORT_VALIDITY, k, v, NULL, 0);
+    ap->validity_known = true;
+    ap->last_validity = v;
+    *LENGTH = (MESSAGE_SIZE_TYPE)len;
+    *VALIDITY = v;
+    *RETURN_CODE = NO_ERROR;
+}
+
+void GET_SAMPLING_PORT_ID(
+    /*in */ const char *SAMPLING_PORT_NAME,
+    /*out*/ SAMPLING_PORT_ID_TYPE *SAMPLING_PORT_ID,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
+{
+    apex__sync();
+    int k = apex__port_by_name(SAMPLING_PORT_NAME, SKE_PORT_SAMPLING);
+    if (k < 0 || !apex__rt.ports[k].created) {
+        *RETURN_CODE = INVALID_CONFIG;
+        return;
+    }
+    *SAMPLING_PORT_ID = k + 1;
+    *RETURN_CODE = NO_ERROR;
+}
+
+void GET_SAMPLING_PORT_STATUS(
+    /*in */ SAMPLING_PORT_ID_TYPE SAMPLING_PORT_ID,
+    /*out*/ SAMPLING_PORT_STATUS_TYPE *SAMPLING_PORT_STATUS,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
+{
+    apex__sync();
+    int k = apex__port_index(SAMPLING_PORT_ID, SKE_PORT_SAMPLING);
+    if (k < 0) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    const ske_port_desc_t *d = &apex__rt.ctl->ports[k];
+    SAMPLING_PORT_STATUS->REFRESH_PERIOD = d->refresh_ns;
+    SAMPLING_PORT_STATUS->MAX_MESSAGE_SIZE = (MESSAGE_SIZE_TYPE)d->max_size;
+    SAMPLING_PORT_STATUS->PORT_DIRECTION = (PORT_DIRECTION_TYPE)d->dir;
+    SAMPLING_PORT_STATUS->LAST_MSG_VALIDITY = apex__rt.ports[k].last_validity;
+    *RETURN_CODE = NO_ERROR;
+}

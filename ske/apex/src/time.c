@@ -1,0 +1,54 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* APEX time management: TIMED_WAIT, PERIODIC_WAIT, GET_TIME (ARINC 653 Part 1, 3.4.2). */
+#include "apex__rt.h"
+
+void TIMED_WAIT(
+    /*in */ SYSTEM_TIME_TYPE DELAY_TIME,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
+{
+    apex_rt_t *rt = &apex__rt;
+    apex__sync();
+    apex_proc_t *p = rt->current;
+    if (!p) {
+        *RETURN_CODE = INVALID_MODE; /* the initialisation process cannot wait */
+        return;
+    }
+    if (DELAY_TIME < 0) {
+        *RETURN_CODE = INVALID_PARAM; /* includes INFINITE_TIME_VALUE */
+        return;
+    }
+    *RETURN_CODE = NO_ERROR;
+    if (DELAY_TIME == 0) {
+        /* Round robin: to the back of the ready processes of the same priority. */
+        apex__make_ready(p);
+        swapcontext(&p->ctx, &rt->sched_ctx);
+        return;
+    }
+    p->wait = WAIT_DELAY;
+    p->wake_at = apex__now() + DELAY_TIME;
+    apex__block(p);
+}
+
+void PERIODIC_WAIT(
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
+{
+    apex__sync();
+    apex_proc_t *p = apex__rt.current;
+    if (!p || p->attr.PERIOD == INFINITE_TIME_VALUE) {
+        *RETURN_CODE = INVALID_MODE;
+        return;
+    }
+    p->wait = WAIT_PERIOD;
+    p->wake_at = p->next_release;
+    *RETURN_CODE = NO_ERROR;
+    apex__block(p);
+}
+
+void GET_TIME(
+    /*out*/ SYSTEM_TIME_TYPE *SYSTEM_TIME,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
+{
+    apex__sync();
+    *SYSTEM_TIME = apex__now();
+    *RETURN_CODE = NO_ERROR;
+}

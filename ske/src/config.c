@@ -1,0 +1,871 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Loads an ARINC 653 module XML: schema validation through libxml2, then the rules of the
+ * standard that a schema cannot say (schedule fits the major frame, channels agree, ...). */
+#include "ske/config.h"
+
+#include <errno.h>
+#include <libgen.h>
+#include <limits.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <libxml/parser.h>
+#include <libxml/tree.h>
+#include <libxml/xmlschemas.h>
+
+#ifndef IMA_SCHEMA_DIR
+#define IMA_SCHEMA_DIR "config/schema"
+#endif
+
+#define EXT_NS "urn:ima-testbed:arinc653-linux:1"
+#define SCHEMA_FILE "ima653_module.xsd"
+
+typedef struct {
+    ske_module_cfg_t *m;
+    ske_diag_t *diag;
+    const ske_load_opts_t *opts;
+    bool failed;
+} loader_t;
+
+/* ---- diagnostics ---------------------------------------------------------------------- */
+
+static void diag_set(ske_diag_t *d, const char *file, int line, const char *element,
+                     const char *rule, const char *fmt, ...) __attribute__((format(printf, 6, 7)));
+
+static void diag_set(ske_diag_t *d, const char *file, int line, const char *element,
+                     const char *rule, const char *fmt, ...)
+{
+    va_list ap;
+    snprintf(d->file, sizeof d->file, "%s", file ? file : "?");
+    d->line = line;
+    snprintf(d->element, sizeof d->element, "%s", element ? element : "");
+    snprintf(d->rule, sizeof d->rule, "%s", rule ? rule : "");
+    va_start(ap, fmt);
+    vsnprintf(d->message, sizeof d->message, fmt, ap);
+    va_end(ap);
+}
+
+void ske_diag_format(const ske_diag_t *d, char *buf, size_t len)
+{
+    if (d->element[0] && d->rule[0])
+        snprintf(buf, len, "%s:%d: error: %s: %s (rule: %s)", d->file, d->line, d->element,
+                 d->message, d->rule);
+    else if (d->element[0])
+        snprintf(buf, len, "%s:%d: error: %s: %s", d->file, d->line, d->element, d->message);
+    else
+        snprintf(buf, len, "%s:%d: error: %s", d->file, d->line, d->message);
+}
+
+/* Fails the load at `node` unless an earlier rule already failed (the first error wins). */
+static void fail(loader_t *L, const xmlNode *node, const char *rule, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+static void fail(loader_t *L, const xmlNode *node, const char *rule, const char *fmt, ...)
+{
+    if (L->failed)
+        return;
+    char msg[768];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    diag_set(L->diag, L->m->path, node ? (int)xmlGetLineNo(node) : 0,
+             node ? (const char *)node->name : "", rule, "%s", msg);
+    L->failed = true;
+}
+
+/* ---- numbers -------------------------------------------------------------------------- */
+
+bool ske_parse_seconds(const char *s, int64_t *ns)
+{
+    if (!s || !*s)
+        return false;
+    int64_t whole = 0, frac = 0;
+    int frac_digits = 0;
+    const char *p = s;
+    if (*p < '0' || *p > '9')
+        return false;
+    for (; *p >= '0' && *p <= '9'; p++) {
+        if (whole > (INT64_MAX / 1000000000LL - 9) / 10)
+            return false;
+        whole = whole * 10 + (*p - '0');
+    }
+    if (*p == '.') {
+        p++;
+        if (*p < '0' || *p > '9')
+            return false;
+        for (; *p >= '0' && *p <= '9'; p++) {
+            if (++frac_digits > 9)
+                return false;
+            frac = frac * 10 + (*p - '0');
+        }
+        for (int i = frac_digits; i < 9; i++)
+            frac *= 10;
+    }
+    if (*p)
+        return false;
+    *ns = whole * 1000000000LL + frac;
+    return true;
+}
+
+bool ske_parse_u64(const char *s, uint64_t *v)
+{
+    if (!s || !*s || *s == '-' || *s == '+' || *s == ' ')
+        return false;
+    int base = (s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) ? 16 : 10;
+    if (base == 16 && !s[2])
+        return false;
+    char *end;
+    errno = 0;
+    unsigned long long x = strtoull(s, &end, base);
+    if (errno || *end)
+        return false;
+    *v = x;
+    return true;
+}
+
+/* ---- XML helpers ---------------------------------------------------------------------- */
+
+static bool is_elem(const xmlNode *n, const char *name, bool ext)
+{
+    if (n->type != XML_ELEMENT_NODE || strcmp((const char *)n->name, name) != 0)
+        return false;
+    bool in_ext = n->ns && n->ns->href && strcmp((const char *)n->ns->href, EXT_NS) == 0;
+    return ext ? in_ext : !n->ns;
+}
+
+/* Attribute value copied into buf; false when absent. */
+static bool attr(const xmlNode *n, const char *name, char *buf, size_t len)
+{
+    xmlChar *v = xmlGetNoNsProp(n, (const xmlChar *)name);
+    if (!v)
+        return false;
+    snprintf(buf, len, "%s", (const char *)v);
+    xmlFree(v);
+    return true;
+}
+
+static bool attr_seconds(loader_t *L, const xmlNode *n, const char *name, int64_t *ns, bool required)
+{
+    char buf[128];
+    if (!attr(n, name, buf, sizeof buf)) {
+        if (required)
+            fail(L, n, "required attribute", "attribute %s is missing", name);
+        return false;
+    }
+    if (!ske_parse_seconds(buf, ns)) {
+        fail(L, n, "durations are decimal seconds",
+             "%s='%s' is not a valid duration: expected decimal seconds such as 0.010, "
+             "at most 9 decimals", name, buf);
+        return false;
+    }
+    return true;
+}
+
+static bool attr_u64(loader_t *L, const xmlNode *n, const char *name, uint64_t *v, uint64_t max,
+                     bool required)
+{
+    char buf[128];
+    if (!attr(n, name, buf, sizeof buf)) {
+        if (required)
+            fail(L, n, "required attribute", "attribute %s is missing", name);
+        return false;
+    }
+    if (!ske_parse_u64(buf, v) || *v > max) {
+        fail(L, n, "numbers are non-negative integers",
+             "%s='%s' is not a valid number (expected an integer from 0 to %llu)", name, buf,
+             (unsigned long long)max);
+        return false;
+    }
+    return true;
+}
+
+static bool attr_bool(const xmlNode *n, const char *name, bool dflt)
+{
+    char buf[16];
+    if (!attr(n, name, buf, sizeof buf))
+        return dflt;
+    return strcmp(buf, "true") == 0 || strcmp(buf, "1") == 0;
+}
+
+static bool attr_name(loader_t *L, const xmlNode *n, const char *name, char *out)
+{
+    char buf[256];
+    if (!attr(n, name, buf, sizeof buf)) {
+        fail(L, n, "required attribute", "attribute %s is missing", name);
+        return false;
+    }
+    if (strlen(buf) >= SKE_NAME_MAX) {
+        fail(L, n, "names have at most 30 characters", "%s='%s' is too long", name, buf);
+        return false;
+    }
+    snprintf(out, SKE_NAME_MAX, "%s", buf);
+    return true;
+}
+
+int ske_config_partition_by_id(const ske_module_cfg_t *m, int32_t id)
+{
+    for (int i = 0; i < m->n_partitions; i++)
+        if (m->partitions[i].id == id)
+            return i;
+    return -1;
+}
+
+int ske_config_port_by_name(const ske_partition_cfg_t *p, const char *name)
+{
+    for (int i = 0; i < p->n_ports; i++)
+        if (strcmp(p->ports[i].name, name) == 0)
+            return i;
+    return -1;
+}
+
+/* A partition reference: PartitionIdentifier and PartitionName must name the same one. */
+static int partition_ref(loader_t *L, const xmlNode *n)
+{
+    uint64_t id;
+    char name[SKE_NAME_MAX];
+    if (!attr_u64(L, n, "PartitionIdentifier", &id, INT32_MAX, true) ||
+        !attr_name(L, n, "PartitionName", name))
+        return -1;
+    int i = ske_config_partition_by_id(L->m, (int32_t)id);
+    if (i < 0) {
+        fail(L, n, "references name a declared Partition",
+             "unknown partition: no Partition has PartitionIdentifier=%llu (PartitionName='%s')",
+             (unsigned long long)id, name);
+        return -1;
+    }
+    if (strcmp(L->m->partitions[i].name, name) != 0) {
+        fail(L, n, "PartitionIdentifier and PartitionName name the same partition",
+             "PartitionIdentifier=%llu is partition '%s', not '%s'", (unsigned long long)id,
+             L->m->partitions[i].name, name);
+        return -1;
+    }
+    return i;
+}
+
+/* ---- schema validation ---------------------------------------------------------------- */
+
+static void schema_error(void *ctx, xmlErrorPtr err)
+{
+    loader_t *L = ctx;
+    if (L->failed || !err)
+        return;
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message ? err->message : "schema error");
+    size_t n = strlen(msg);
+    while (n && (msg[n - 1] == '\n' || msg[n - 1] == ' '))
+        msg[--n] = '\0';
+    const char *elem = "";
+    const xmlNode *node = err->node;
+    const char *attr_name_s = NULL;
+    if (node && node->type == XML_ATTRIBUTE_NODE && node->parent) {
+        attr_name_s = (const char *)node->name;
+        node = node->parent;
+    }
+    if (node && node->type == XML_ELEMENT_NODE)
+        elem = (const char *)node->name;
+    int line = err->line ? err->line : (node ? (int)xmlGetLineNo(node) : 0);
+    /* Say what a malformed number means rather than quoting the schema's regular expression. */
+    char value[128] = "";
+    if (attr_name_s && node)
+        attr(node, attr_name_s, value, sizeof value);
+    size_t an = attr_name_s ? strlen(attr_name_s) : 0;
+    if (attr_name_s && an > 7 && strcmp(attr_name_s + an - 7, "Seconds") == 0) {
+        diag_set(L->diag, L->m->path, line, elem, "durations are decimal seconds",
+                 "%s='%s' is not a valid duration: expected decimal seconds such as 0.010, "
+                 "at most 9 decimals", attr_name_s, value);
+    } else if (attr_name_s && (strstr(attr_name_s, "Identifier") || strstr(attr_name_s, "Size") ||
+                               strstr(attr_name_s, "Nb"))) {
+        diag_set(L->diag, L->m->path, line, elem, "numbers are positive integers",
+                 "%s='%s' is not a valid number", attr_name_s, value);
+    } else {
+        diag_set(L->diag, L->m->path, line, elem, "schema " SCHEMA_FILE, "%s", msg);
+    }
+    L->failed = true;
+}
+
+static void parse_error(void *ctx, xmlErrorPtr err)
+{
+    loader_t *L = ctx;
+    if (L->failed || !err)
+        return;
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", err->message ? err->message : "XML error");
+    size_t n = strlen(msg);
+    while (n && (msg[n - 1] == '\n' || msg[n - 1] == ' '))
+        msg[--n] = '\0';
+    diag_set(L->diag, L->m->path, err->line, "", "well-formed XML", "%s", msg);
+    L->failed = true;
+}
+
+static void silent(void *ctx, const char *msg, ...) { (void)ctx; (void)msg; }
+
+static int validate_schema(loader_t *L, xmlDocPtr doc)
+{
+    char xsd[SKE_PATH_MAX];
+    const char *dir = L->opts && L->opts->schema_dir ? L->opts->schema_dir : IMA_SCHEMA_DIR;
+    snprintf(xsd, sizeof xsd, "%s/%s", dir, SCHEMA_FILE);
+    if (access(xsd, R_OK) != 0) {
+        diag_set(L->diag, xsd, 0, "", "", "cannot read the module schema: %s", strerror(errno));
+        return SKE_E_IO;
+    }
+    int rc = SKE_OK;
+    xmlSchemaParserCtxtPtr pctx = xmlSchemaNewParserCtxt(xsd);
+    xmlSchemaPtr schema = pctx ? xmlSchemaParse(pctx) : NULL;
+    xmlSchemaValidCtxtPtr vctx = schema ? xmlSchemaNewValidCtxt(schema) : NULL;
+    if (!vctx) {
+        diag_set(L->diag, xsd, 0, "", "", "the module schema itself is invalid");
+        rc = SKE_E_IO;
+        goto out;
+    }
+    xmlSchemaSetValidStructuredErrors(vctx, schema_error, L);
+    if (xmlSchemaValidateDoc(vctx, doc) != 0) {
+        if (!L->failed)
+            fail(L, xmlDocGetRootElement(doc), "schema " SCHEMA_FILE, "document does not validate");
+        rc = SKE_E_CONFIG;
+    }
+out:
+    if (vctx)
+        xmlSchemaFreeValidCtxt(vctx);
+    if (schema)
+        xmlSchemaFree(schema);
+    if (pctx)
+        xmlSchemaFreeParserCtxt(pctx);
+    return rc;
+}
+
+/* ---- elements ------------------------------------------------------------------------- */
+
+static void split_args(loader_t *L, const xmlNode *n, ske_partition_cfg_t *p, const char *args)
+{
+    p->argv[0] = strdup(p->name);
+    p->argc = 1;
+    if (!args)
+        return;
+    char *copy = strdup(args), *save = NULL;
+    for (char *tok = strtok_r(copy, " \t\n", &save); tok; tok = strtok_r(NULL, " \t\n", &save)) {
+        if (p->argc >= SKE_MAX_ARGS - 1) {
+            fail(L, n, "at most 30 arguments", "too many Arguments for partition '%s'", p->name);
+            break;
+        }
+        p->argv[p->argc++] = strdup(tok);
+    }
+    free(copy);
+}
+
+static void load_port(loader_t *L, const xmlNode *n, ske_partition_cfg_t *p, ske_port_kind_t kind)
+{
+    if (p->n_ports >= SKE_MAX_PORTS) {
+        fail(L, n, "at most 64 ports per partition", "too many ports in partition '%s'", p->name);
+        return;
+    }
+    ske_port_cfg_t *port = &p->ports[p->n_ports];
+    memset(port, 0, sizeof *port);
+    port->kind = kind;
+    port->channel = -1;
+    port->line = (int)xmlGetLineNo(n);
+    if (!attr_name(L, n, "Name", port->name))
+        return;
+    if (ske_config_port_by_name(p, port->name) >= 0) {
+        fail(L, n, "port names are unique within a partition",
+             "partition '%s' declares port '%s' twice", p->name, port->name);
+        return;
+    }
+    char dir[32] = "";
+    attr(n, "Direction", dir, sizeof dir);
+    port->dir = strcmp(dir, "DESTINATION") == 0 ? SKE_DIR_DESTINATION : SKE_DIR_SOURCE;
+    uint64_t v;
+    if (attr_u64(L, n, "MaxMessageSize", &v, 1u << 20, true)) {
+        if (v == 0)
+            fail(L, n, "MaxMessageSize is positive", "MaxMessageSize must be at least 1");
+        port->max_size = (uint32_t)v;
+    }
+    if (kind == SKE_PORT_SAMPLING) {
+        if (attr_seconds(L, n, "RefreshRateSeconds", &port->refresh_ns, true) && port->refresh_ns == 0)
+            fail(L, n, "RefreshRateSeconds is positive", "RefreshRateSeconds must be greater than 0");
+    } else if (attr_u64(L, n, "MaxNbMessages", &v, 1u << 20, true)) {
+        if (v == 0)
+            fail(L, n, "MaxNbMessages is positive", "MaxNbMessages must be at least 1");
+        port->max_nb = (uint32_t)v;
+    }
+    p->n_ports++;
+}
+
+static void load_partition(loader_t *L, const xmlNode *n)
+{
+    ske_module_cfg_t *m = L->m;
+    if (m->n_partitions >= SKE_MAX_PARTITIONS) {
+        fail(L, n, "at most 32 partitions", "too many partitions");
+        return;
+    }
+    ske_partition_cfg_t *p = &m->partitions[m->n_partitions];
+    memset(p, 0, sizeof *p);
+    p->line = (int)xmlGetLineNo(n);
+    uint64_t id;
+    if (!attr_u64(L, n, "PartitionIdentifier", &id, INT32_MAX, true) ||
+        !attr_name(L, n, "PartitionName", p->name))
+        return;
+    p->id = (int32_t)id;
+    for (int i = 0; i < m->n_partitions; i++) {
+        if (m->partitions[i].id == p->id)
+            fail(L, n, "partition identifiers are unique",
+                 "PartitionIdentifier=%d is already used by partition '%s' (line %d)", p->id,
+                 m->partitions[i].name, m->partitions[i].line);
+        else if (strcmp(m->partitions[i].name, p->name) == 0)
+            fail(L, n, "partition names are unique",
+                 "PartitionName='%s' is already used (line %d)", p->name, m->partitions[i].line);
+    }
+    if (!attr(n, "Criticality", p->criticality, sizeof p->criticality))
+        snprintf(p->criticality, sizeof p->criticality, "LEVEL_E");
+    p->system_partition = attr_bool(n, "SystemPartition", false);
+    attr(n, "EntryPoint", p->entry_point, sizeof p->entry_point);
+    bool have_linux = false;
+    for (const xmlNode *c = n->children; c; c = c->next) {
+        if (is_elem(c, "Sampling_Port", false))
+            load_port(L, c, p, SKE_PORT_SAMPLING);
+        else if (is_elem(c, "Queuing_Port", false))
+            load_port(L, c, p, SKE_PORT_QUEUING);
+        else if (is_elem(c, "Process", false)) {
+            if (p->n_processes < SKE_MAX_PORTS) {
+                ske_process_cfg_t *pr = &p->processes[p->n_processes++];
+                pr->line = (int)xmlGetLineNo(c);
+                attr_name(L, c, "Name", pr->name);
+                uint64_t ss = 0;
+                if (attr_u64(L, c, "StackSize", &ss, UINT32_MAX, false))
+                    pr->stack_size = (uint32_t)ss;
+            }
+        } else if (is_elem(c, "Linux", true)) {
+            have_linux = true;
+            attr(c, "Executable", p->exe_name, sizeof p->exe_name);
+            char args[2048];
+            split_args(L, c, p, attr(c, "Arguments", args, sizeof args) ? args : NULL);
+        }
+    }
+    if (!have_linux)
+        fail(L, n, "each Partition has an ima:Linux element",
+             "partition '%s' does not say which program runs it (ima:Linux Executable=...)", p->name);
+    m->n_partitions++;
+}
+
+static void load_memory(loader_t *L, const xmlNode *n)
+{
+    int pi = partition_ref(L, n);
+    if (pi < 0)
+        return;
+    ske_partition_cfg_t *p = &L->m->partitions[pi];
+    for (const xmlNode *c = n->children; c; c = c->next) {
+        if (!is_elem(c, "Memory_Requirements", false))
+            continue;
+        uint64_t sz;
+        if (attr_u64(L, c, "SizeBytes", &sz, (uint64_t)1 << 40, true))
+            p->memory_bytes += sz;
+    }
+}
+
+static void load_schedule(loader_t *L, const xmlNode *n)
+{
+    ske_module_cfg_t *m = L->m;
+    if (!attr_seconds(L, n, "MajorFrameSeconds", &m->major_frame_ns, true))
+        return;
+    if (m->major_frame_ns <= 0) {
+        fail(L, n, "the major frame is positive", "MajorFrameSeconds must be greater than 0");
+        return;
+    }
+    bool scheduled[SKE_MAX_PARTITIONS] = {false};
+    for (const xmlNode *ps = n->children; ps && !L->failed; ps = ps->next) {
+        if (!is_elem(ps, "Partition_Schedule", false))
+            continue;
+        int pi = partition_ref(L, ps);
+        if (pi < 0)
+            return;
+        ske_partition_cfg_t *p = &m->partitions[pi];
+        if (scheduled[pi]) {
+            fail(L, ps, "one Partition_Schedule per partition",
+                 "partition '%s' has a second Partition_Schedule", p->name);
+            return;
+        }
+        scheduled[pi] = true;
+        if (!attr_seconds(L, ps, "PeriodSeconds", &p->period_ns, true))
+            return;
+        if (p->period_ns <= 0 || m->major_frame_ns % p->period_ns != 0) {
+            fail(L, ps, "the partition period divides the major frame",
+                 "PeriodSeconds of partition '%s' (%lld ns) does not divide the major frame "
+                 "(%lld ns)", p->name, (long long)p->period_ns, (long long)m->major_frame_ns);
+            return;
+        }
+        int64_t declared_duration = -1;
+        if (attr_seconds(L, ps, "PeriodDurationSeconds", &declared_duration, false) == false &&
+            L->failed)
+            return;
+        int64_t total = 0;
+        bool anchor_set = false;
+        for (const xmlNode *w = ps->children; w && !L->failed; w = w->next) {
+            if (!is_elem(w, "Window_Schedule", false))
+                continue;
+            if (m->n_windows >= SKE_MAX_WINDOWS) {
+                fail(L, w, "at most 256 windows", "too many windows");
+                return;
+            }
+            ske_window_cfg_t *win = &m->windows[m->n_windows];
+            memset(win, 0, sizeof *win);
+            win->line = (int)xmlGetLineNo(w);
+            win->partition = pi;
+            uint64_t wid;
+            if (!attr_u64(L, w, "WindowIdentifier", &wid, INT32_MAX, true) ||
+                !attr_seconds(L, w, "WindowStartSeconds", &win->offset_ns, true) ||
+                !attr_seconds(L, w, "WindowDurationSeconds", &win->duration_ns, true))
+                return;
+            win->id = (int32_t)wid;
+            for (int i = 0; i < m->n_windows; i++)
+                if (m->windows[i].id == win->id) {
+                    fail(L, w, "window identifiers are unique",
+                         "WindowIdentifier=%d is already used (line %d)", win->id,
+                         m->windows[i].line);
+                    return;
+                }
+            if (win->duration_ns <= 0) {
+                fail(L, w, "windows have a positive duration", "WindowDurationSeconds must be "
+                     "greater than 0");
+                return;
+            }
+            if (win->offset_ns + win->duration_ns > m->major_frame_ns) {
+                fail(L, w, "windows end within the major frame",
+                     "window %d of partition '%s' runs from %lld ns to %lld ns, past the major "
+                     "frame of %lld ns", win->id, p->name, (long long)win->offset_ns,
+                     (long long)(win->offset_ns + win->duration_ns), (long long)m->major_frame_ns);
+                return;
+            }
+            win->period_start = attr_bool(w, "PartitionPeriodStart", false);
+            if (win->period_start && !anchor_set) {
+                p->period_anchor_ns = win->offset_ns % p->period_ns;
+                anchor_set = true;
+            }
+            total += win->duration_ns;
+            p->n_windows++;
+            m->n_windows++;
+        }
+        if (!anchor_set) {
+            /* No window is marked as a period start: the first one starts the period. */
+            int64_t first = INT64_MAX;
+            for (int i = 0; i < m->n_windows; i++)
+                if (m->windows[i].partition == pi && m->windows[i].offset_ns < first)
+                    first = m->windows[i].offset_ns;
+            p->period_anchor_ns = first == INT64_MAX ? 0 : first % p->period_ns;
+        }
+        int64_t periods = m->major_frame_ns / p->period_ns;
+        p->duration_ns = total / periods;
+        if (declared_duration >= 0 && declared_duration * periods != total) {
+            fail(L, ps, "PeriodDurationSeconds is the window time per period",
+                 "partition '%s' declares %lld ns per period but its windows give %lld ns per "
+                 "period", p->name, (long long)declared_duration, (long long)(total / periods));
+            return;
+        }
+    }
+}
+
+static int cmp_window(const void *a, const void *b)
+{
+    const ske_window_cfg_t *x = a, *y = b;
+    return (x->offset_ns > y->offset_ns) - (x->offset_ns < y->offset_ns);
+}
+
+static void check_windows(loader_t *L, const xmlNode *root)
+{
+    ske_module_cfg_t *m = L->m;
+    qsort(m->windows, (size_t)m->n_windows, sizeof m->windows[0], cmp_window);
+    for (int i = 1; i < m->n_windows; i++) {
+        const ske_window_cfg_t *a = &m->windows[i - 1], *b = &m->windows[i];
+        if (b->offset_ns < a->offset_ns + a->duration_ns) {
+            /* Report at the later window, naming the one it overlaps. */
+            const ske_window_cfg_t *late = a->line > b->line ? a : b;
+            const ske_window_cfg_t *early = late == a ? b : a;
+            L->failed = false; /* no earlier failure can reach here */
+            diag_set(L->diag, m->path, late->line, "Window_Schedule",
+                     "windows of a module schedule do not overlap",
+                     "window %d of partition '%s' [%lld ns, %lld ns) overlaps window %d of "
+                     "partition '%s' [%lld ns, %lld ns) (line %d)", late->id,
+                     m->partitions[late->partition].name, (long long)late->offset_ns,
+                     (long long)(late->offset_ns + late->duration_ns), early->id,
+                     m->partitions[early->partition].name, (long long)early->offset_ns,
+                     (long long)(early->offset_ns + early->duration_ns), early->line);
+            L->failed = true;
+            return;
+        }
+    }
+    for (int i = 0; i < m->n_partitions; i++) {
+        if (m->partitions[i].n_windows == 0) {
+            L->failed = false;
+            diag_set(L->diag, m->path, m->partitions[i].line, "Partition",
+                     "every partition has at least one window",
+                     "partition '%s' has no window in the Module_Schedule",
+                     m->partitions[i].name);
+            L->failed = true;
+            return;
+        }
+    }
+    (void)root;
+}
+
+static bool load_endpoint(loader_t *L, const xmlNode *ep, ske_endpoint_t *out)
+{
+    for (const xmlNode *c = ep->children; c; c = c->next) {
+        if (!is_elem(c, "Standard_Partition", false))
+            continue;
+        int pi = partition_ref(L, c);
+        if (pi < 0)
+            return false;
+        char port[SKE_NAME_MAX];
+        if (!attr_name(L, c, "PortName", port))
+            return false;
+        int po = ske_config_port_by_name(&L->m->partitions[pi], port);
+        if (po < 0) {
+            fail(L, c, "a channel connects ports that partitions declare",
+                 "partition '%s' declares no port named '%s'", L->m->partitions[pi].name, port);
+            return false;
+        }
+        out->partition = pi;
+        out->port = po;
+        return true;
+    }
+    fail(L, ep, "a channel end names a Standard_Partition", "missing Standard_Partition");
+    return false;
+}
+
+static ske_port_cfg_t *port_of(ske_module_cfg_t *m, ske_endpoint_t e)
+{
+    return &m->partitions[e.partition].ports[e.port];
+}
+
+static const char *kind_name(ske_port_kind_t k)
+{
+    return k == SKE_PORT_SAMPLING ? "sampling" : "queuing";
+}
+
+static void load_channel(loader_t *L, const xmlNode *n)
+{
+    ske_module_cfg_t *m = L->m;
+    if (m->n_channels >= SKE_MAX_CHANNELS) {
+        fail(L, n, "at most 256 channels", "too many channels");
+        return;
+    }
+    ske_channel_cfg_t *ch = &m->channels[m->n_channels];
+    memset(ch, 0, sizeof *ch);
+    ch->line = (int)xmlGetLineNo(n);
+    uint64_t id;
+    if (!attr_u64(L, n, "ChannelIdentifier", &id, INT32_MAX, true) ||
+        !attr_name(L, n, "ChannelName", ch->name))
+        return;
+    ch->id = (int32_t)id;
+    for (int i = 0; i < m->n_channels; i++)
+        if (m->channels[i].id == ch->id) {
+            fail(L, n, "channel identifiers are unique",
+                 "ChannelIdentifier=%d is already used (line %d)", ch->id, m->channels[i].line);
+            return;
+        }
+    const xmlNode *src_node = NULL;
+    for (const xmlNode *c = n->children; c && !L->failed; c = c->next) {
+        if (is_elem(c, "Source", false)) {
+            src_node = c;
+            if (!load_endpoint(L, c, &ch->src))
+                return;
+        } else if (is_elem(c, "Destination", false)) {
+            if (ch->n_dst >= SKE_MAX_DESTINATIONS) {
+                fail(L, c, "at most 16 destinations per channel", "too many destinations");
+                return;
+            }
+            if (!load_endpoint(L, c, &ch->dst[ch->n_dst]))
+                return;
+            ch->n_dst++;
+        }
+    }
+    if (!src_node || ch->n_dst == 0) {
+        fail(L, n, "a channel has one Source and at least one Destination",
+             "channel '%s' lacks a %s", ch->name, src_node ? "Destination" : "Source");
+        return;
+    }
+    ske_port_cfg_t *sp = port_of(m, ch->src);
+    ch->kind = sp->kind;
+    if (sp->dir != SKE_DIR_SOURCE) {
+        fail(L, src_node, "a channel's Source is a SOURCE port",
+             "port '%s' of partition '%s' is a DESTINATION port, it cannot be the source of "
+             "channel '%s'", sp->name, m->partitions[ch->src.partition].name, ch->name);
+        return;
+    }
+    if (sp->channel >= 0) {
+        fail(L, src_node, "a port belongs to one channel",
+             "port '%s' of partition '%s' is already the source of channel '%s'", sp->name,
+             m->partitions[ch->src.partition].name, m->channels[sp->channel].name);
+        return;
+    }
+    if (ch->kind == SKE_PORT_QUEUING && ch->n_dst > 1) {
+        fail(L, n, "a queuing channel has exactly one destination",
+             "queuing channel '%s' has %d destinations", ch->name, ch->n_dst);
+        return;
+    }
+    sp->channel = m->n_channels;
+    for (int d = 0; d < ch->n_dst; d++) {
+        ske_port_cfg_t *dp = port_of(m, ch->dst[d]);
+        const char *pname = m->partitions[ch->dst[d].partition].name;
+        if (dp->kind != ch->kind) {
+            fail(L, n, "a channel connects ports of one kind",
+                 "channel '%s' connects %s port '%s' to %s port '%s' of partition '%s'",
+                 ch->name, kind_name(sp->kind), sp->name, kind_name(dp->kind), dp->name, pname);
+            return;
+        }
+        if (dp->dir != SKE_DIR_DESTINATION) {
+            fail(L, n, "a channel's Destination is a DESTINATION port",
+                 "port '%s' of partition '%s' is a SOURCE port, it cannot be a destination of "
+                 "channel '%s'", dp->name, pname, ch->name);
+            return;
+        }
+        if (dp->max_size != sp->max_size) {
+            fail(L, n, "the ports of a channel have the same MaxMessageSize",
+                 "channel '%s': source port '%s' has MaxMessageSize=%u but destination port "
+                 "'%s' of partition '%s' has %u", ch->name, sp->name, sp->max_size, dp->name,
+                 pname, dp->max_size);
+            return;
+        }
+        if (dp->channel >= 0) {
+            fail(L, n, "a port belongs to one channel",
+                 "port '%s' of partition '%s' is already a destination of channel '%s'",
+                 dp->name, pname, m->channels[dp->channel].name);
+            return;
+        }
+        dp->channel = m->n_channels;
+    }
+    m->n_channels++;
+}
+
+/* Bare names are looked up in the partition path; names with a slash are relative to the
+ * module file's folder. */
+static void resolve_executable(loader_t *L, ske_partition_cfg_t *p)
+{
+    char cand[2 * SKE_PATH_MAX + 2];
+    if (strchr(p->exe_name, '/')) {
+        if (p->exe_name[0] == '/') {
+            snprintf(cand, sizeof cand, "%s", p->exe_name);
+        } else {
+            char dir[SKE_PATH_MAX];
+            snprintf(dir, sizeof dir, "%s", L->m->path);
+            snprintf(cand, sizeof cand, "%s/%s", dirname(dir), p->exe_name);
+        }
+        if (access(cand, X_OK) == 0 && realpath(cand, p->executable))
+            return;
+    } else {
+        const char *path = L->opts && L->opts->partition_path ? L->opts->partition_path : "";
+        char *copy = strdup(path), *save = NULL;
+        for (char *d = strtok_r(copy, ":", &save); d; d = strtok_r(NULL, ":", &save)) {
+            snprintf(cand, sizeof cand, "%s/%s", d, p->exe_name);
+            if (access(cand, X_OK) == 0 && realpath(cand, p->executable)) {
+                free(copy);
+                return;
+            }
+        }
+        free(copy);
+    }
+    L->failed = false;
+    diag_set(L->diag, L->m->path, p->line, "Partition", "the partition's program exists",
+             "partition '%s': executable '%s' not found%s%s", p->name, p->exe_name,
+             strchr(p->exe_name, '/') ? "" : " in the partition path ",
+             strchr(p->exe_name, '/') ? "" :
+             (L->opts && L->opts->partition_path ? L->opts->partition_path : "(empty)"));
+    L->failed = true;
+}
+
+static void load_module(loader_t *L, xmlNode *root)
+{
+    ske_module_cfg_t *m = L->m;
+    attr(root, "ModuleName", m->module_name, sizeof m->module_name);
+    snprintf(m->node, sizeof m->node, "node1");
+    m->time_mode = SKE_TIME_EMULATED;
+    const xmlNode *schedule = NULL;
+    for (xmlNode *c = root->children; c && !L->failed; c = c->next) {
+        if (is_elem(c, "Module_Extension", true)) {
+            char buf[SKE_NAME_MAX];
+            if (attr(c, "Node", buf, sizeof buf))
+                snprintf(m->node, sizeof m->node, "%s", buf);
+            if (attr(c, "TimeMode", buf, sizeof buf) && strcmp(buf, "realtime") == 0)
+                m->time_mode = SKE_TIME_REALTIME;
+        } else if (is_elem(c, "Partition", false)) {
+            load_partition(L, c);
+        }
+    }
+    for (xmlNode *c = root->children; c && !L->failed; c = c->next) {
+        if (is_elem(c, "Partition_Memory", false))
+            load_memory(L, c);
+        else if (is_elem(c, "Module_Schedule", false)) {
+            schedule = c;
+            load_schedule(L, c);
+        }
+    }
+    if (!L->failed && schedule)
+        check_windows(L, schedule);
+    for (xmlNode *c = root->children; c && !L->failed; c = c->next) {
+        if (!is_elem(c, "Connection_Table", false))
+            continue;
+        for (xmlNode *ch = c->children; ch && !L->failed; ch = ch->next)
+            if (is_elem(ch, "Channel", false))
+                load_channel(L, ch);
+    }
+    if (L->failed || !(L->opts && L->opts->resolve_executables))
+        return;
+    for (int i = 0; i < m->n_partitions && !L->failed; i++)
+        resolve_executable(L, &m->partitions[i]);
+}
+
+int ske_config_load(const char *path, const ske_load_opts_t *opts, ske_module_cfg_t **out,
+                    ske_diag_t *diag)
+{
+    memset(diag, 0, sizeof *diag);
+    *out = NULL;
+    ske_module_cfg_t *m = calloc(1, sizeof *m);
+    if (!m)
+        return SKE_E_NOMEM;
+    snprintf(m->path, sizeof m->path, "%s", path);
+    loader_t L = {.m = m, .diag = diag, .opts = opts};
+
+    if (access(path, R_OK) != 0) {
+        diag_set(diag, path, 0, "", "", "cannot read the module: %s", strerror(errno));
+        free(m);
+        return SKE_E_IO;
+    }
+    xmlSetGenericErrorFunc(NULL, silent);
+    xmlSetStructuredErrorFunc(&L, parse_error);
+    xmlDocPtr doc = xmlReadFile(path, NULL, XML_PARSE_NONET | XML_PARSE_BIG_LINES);
+    xmlSetStructuredErrorFunc(NULL, NULL);
+    int rc = SKE_OK;
+    if (!doc) {
+        if (!L.failed)
+            diag_set(diag, path, 0, "", "well-formed XML", "cannot parse the module");
+        rc = SKE_E_CONFIG;
+        goto out;
+    }
+    rc = validate_schema(&L, doc);
+    if (rc != SKE_OK)
+        goto out;
+    load_module(&L, xmlDocGetRootElement(doc));
+    if (L.failed)
+        rc = SKE_E_CONFIG;
+out:
+    if (doc)
+        xmlFreeDoc(doc);
+    if (rc != SKE_OK) {
+        ske_config_free(m);
+        return rc;
+    }
+    *out = m;
+    return SKE_OK;
+}
+
+void ske_config_free(ske_module_cfg_t *m)
+{
+    if (!m)
+        return;
+    for (int i = 0; i < m->n_partitions; i++)
+        for (int a = 0; a < m->partitions[i].argc; a++)
+            free(m->partitions[i].argv[a]);
+    free(m);
+}

@@ -1,0 +1,993 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The SKE's supervisor: starts each partition as a process holding only its own ports,
+ * runs the cyclic plan by granting the CPU to one partition at a time, stops a partition
+ * that keeps it past its window, moves queuing messages, and records all of it. */
+#include "ske/ske.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <inttypes.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "ske__stats.h"
+#include "ske__trace.h"
+
+extern char **environ;
+
+#define SPIN_NS 40000 /* busy-wait this long for a yield before sleeping on the futex */
+#define READY_TIMEOUT_NS 10000000000LL /* a partition must attach within 10 s */
+#define HANG_FACTOR 20 /* emulated mode: a window may take this many times its length in wall */
+#define HANG_MIN_NS 2000000000LL /* time (at least 2 s) while using no CPU before it is cut */
+#define SAMPLE_LIMIT 2000000
+
+typedef enum {
+    PS_NOT_STARTED,
+    PS_RUNNING, /* alive: waiting for a grant or holding one */
+    PS_STOPPED, /* SIGSTOPped after an overrun; continued at its next window */
+    PS_EXITED,
+    PS_CRASHED,
+    PS_IDLE, /* SET_PARTITION_MODE(IDLE) */
+} pstate_t;
+
+typedef struct {
+    int fd; /* SKE's read-write descriptor */
+    int fd_ro; /* read-only descriptor for destinations, -1 if not needed */
+    void *mem;
+    size_t size;
+} portmem_t;
+
+typedef struct {
+    const ske_partition_cfg_t *cfg;
+    int index;
+    pid_t pid;
+    pstate_t state;
+    int exit_code; /* exit status or signal number */
+    int ctl_fd;
+    ske_ctl_t *ctl;
+    portmem_t ports[SKE_MAX_PORTS];
+    uint32_t grant_seq;
+    uint32_t mode_request_seq;
+    uint32_t start_condition;
+    uint32_t initial_mode;
+    clockid_t cpu_clock;
+    int64_t cpu_at_yield_ns; /* -1: unknown */
+    int64_t cpu_outside_max_ns;
+    int64_t cpu_ns;
+    uint64_t windows;
+    uint64_t overruns;
+    uint64_t restarts;
+} part_t;
+
+struct ske {
+    const ske_module_cfg_t *cfg;
+    ske_run_opts_t opts;
+    ske_time_mode_t time_mode;
+    char node[SKE_NAME_MAX];
+    part_t parts[SKE_MAX_PARTITIONS];
+    uint64_t chan_messages[SKE_MAX_CHANNELS];
+    uint64_t chan_overflows[SKE_MAX_CHANNELS];
+    ske_trace_t trace;
+    ske_samples_t switch_ns;
+    ske_samples_t jitter_ns;
+    int64_t epoch_mono_ns;
+    int64_t start_mono_ns;
+    int64_t frames_done;
+    int64_t now_ns; /* module time of the current window start */
+    int64_t prev_yield_mono_ns; /* the previous window's yield, for the switch figure */
+    volatile sig_atomic_t stop_signal;
+    volatile sig_atomic_t child_event;
+    char exit_reason[16];
+};
+
+static const char *state_name(pstate_t s)
+{
+    switch (s) {
+    case PS_NOT_STARTED: return "not_started";
+    case PS_RUNNING: return "running";
+    case PS_STOPPED: return "stopped";
+    case PS_EXITED: return "exited";
+    case PS_CRASHED: return "crashed";
+    case PS_IDLE: return "idle";
+    }
+    return "?";
+}
+
+static const char *mode_name(uint32_t m)
+{
+    static const char *names[] = {"IDLE", "COLD_START", "WARM_START", "NORMAL"};
+    return m < 4 ? names[m] : "?";
+}
+
+static bool alive(const part_t *p) { return p->state == PS_RUNNING || p->state == PS_STOPPED; }
+
+void ske_request_stop(ske_t *ske, int signo) { ske->stop_signal = signo; }
+void ske_notify_child(ske_t *ske) { ske->child_event = 1; }
+int ske_stop_signal(const ske_t *ske) { return ske->stop_signal; }
+
+/* ---- memory objects ------------------------------------------------------------------- */
+
+static int memobj(const char *name, size_t size, void **mem)
+{
+    int fd = memfd_create(name, MFD_CLOEXEC);
+    if (fd < 0)
+        return -errno;
+    if (ftruncate(fd, (off_t)size) != 0) {
+        int e = errno;
+        close(fd);
+        return -e;
+    }
+    void *p = mmap(NULL, size, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+    if (p == MAP_FAILED) {
+        int e = errno;
+        close(fd);
+        return -e;
+    }
+    *mem = p;
+    return fd;
+}
+
+/* A second descriptor of the same memory opened read-only: a mapping made through it can
+ * never become writable, not even with mprotect(). */
+static int reopen_ro(int fd)
+{
+    char path[64];
+    snprintf(path, sizeof path, "/proc/self/fd/%d", fd);
+    return open(path, O_RDONLY | O_CLOEXEC);
+}
+
+static int setup_ports(ske_t *s, char *err, size_t errlen)
+{
+    const ske_module_cfg_t *m = s->cfg;
+    /* Sampling channels first: the source's memory object is shared by its destinations. */
+    for (int pi = 0; pi < m->n_partitions; pi++) {
+        part_t *p = &s->parts[pi];
+        for (int k = 0; k < p->cfg->n_ports; k++) {
+            const ske_port_cfg_t *pc = &p->cfg->ports[k];
+            portmem_t *pm = &p->ports[k];
+            pm->fd = pm->fd_ro = -1;
+            if (pc->kind == SKE_PORT_SAMPLING && pc->dir == SKE_DIR_DESTINATION && pc->channel >= 0)
+                continue; /* filled from the source below */
+            char name[80];
+            snprintf(name, sizeof name, "ima-%s-%s", p->cfg->name, pc->name);
+            pm->size = pc->kind == SKE_PORT_SAMPLING ? ske_sampling_map_size(pc->max_size)
+                                                     : ske_queue_map_size(pc->max_size, pc->max_nb);
+            pm->fd = memobj(name, pm->size, &pm->mem);
+            if (pm->fd < 0) {
+                snprintf(err, errlen, "port memory for %s.%s: %s", p->cfg->name, pc->name,
+                         strerror(-pm->fd));
+                return SKE_E_SYS;
+            }
+            if (pc->kind == SKE_PORT_SAMPLING)
+                ske_sampling_init(pm->mem, pc->max_size);
+            else
+                ske_queue_init(pm->mem, pc->max_size, pc->max_nb);
+            if (pc->dir == SKE_DIR_DESTINATION) {
+                pm->fd_ro = reopen_ro(pm->fd);
+                if (pm->fd_ro < 0) {
+                    snprintf(err, errlen, "read-only port descriptor: %s", strerror(errno));
+                    return SKE_E_SYS;
+                }
+            }
+        }
+    }
+    for (int c = 0; c < m->n_channels; c++) {
+        const ske_channel_cfg_t *ch = &m->channels[c];
+        if (ch->kind != SKE_PORT_SAMPLING)
+            continue;
+        const portmem_t *src = &s->parts[ch->src.partition].ports[ch->src.port];
+        for (int d = 0; d < ch->n_dst; d++) {
+            portmem_t *pm = &s->parts[ch->dst[d].partition].ports[ch->dst[d].port];
+            pm->mem = src->mem;
+            pm->size = src->size;
+            pm->fd = -1;
+            pm->fd_ro = reopen_ro(src->fd);
+            if (pm->fd_ro < 0) {
+                snprintf(err, errlen, "read-only port descriptor: %s", strerror(errno));
+                return SKE_E_SYS;
+            }
+        }
+    }
+    return SKE_OK;
+}
+
+/* ---- control blocks ------------------------------------------------------------------- */
+
+static void fill_ctl(ske_t *s, part_t *p)
+{
+    ske_ctl_t *c = p->ctl;
+    memset(c, 0, sizeof *c);
+    c->magic = SKE_ABI_MAGIC;
+    c->version = SKE_ABI_VERSION;
+    c->partition_id = p->cfg->id;
+    snprintf(c->partition_name, sizeof c->partition_name, "%s", p->cfg->name);
+    snprintf(c->node, sizeof c->node, "%s", s->node);
+    c->time_mode = s->time_mode;
+    c->system_partition = p->cfg->system_partition;
+    c->epoch_mono_ns = s->epoch_mono_ns;
+    c->period_ns = p->cfg->period_ns;
+    c->duration_ns = p->cfg->duration_ns;
+    c->period_anchor_ns = p->cfg->period_anchor_ns;
+    c->major_frame_ns = s->cfg->major_frame_ns;
+    c->start_condition = p->start_condition;
+    c->initial_mode = p->initial_mode;
+    c->n_ports = (uint32_t)p->cfg->n_ports;
+    for (int k = 0; k < p->cfg->n_ports; k++) {
+        const ske_port_cfg_t *pc = &p->cfg->ports[k];
+        ske_port_desc_t *d = &c->ports[k];
+        snprintf(d->name, sizeof d->name, "%s", pc->name);
+        d->kind = pc->kind;
+        d->dir = pc->dir;
+        d->max_size = pc->max_size;
+        d->max_nb = pc->max_nb;
+        d->refresh_ns = pc->refresh_ns;
+        d->fd = 4 + k; /* the child's descriptor numbers: 3 is the control block */
+        d->map_size = (uint32_t)p->ports[k].size;
+        d->channel = pc->channel >= 0 ? (uint32_t)s->cfg->channels[pc->channel].id : 0;
+        atomic_store(&d->rx_tail, 0);
+        atomic_store(&d->overflow_ack, 0);
+    }
+    atomic_store(&c->mode, p->initial_mode);
+    p->grant_seq = 0;
+    p->mode_request_seq = 0;
+}
+
+/* ---- trace helpers -------------------------------------------------------------------- */
+
+static void trace_mode(ske_t *s, part_t *p, int64_t t, uint32_t mode, uint32_t from, const char *why)
+{
+    ske_trace_begin(&s->trace, t, p->cfg->name, "mode");
+    ske_trace_str(&s->trace, "partition", p->cfg->name);
+    ske_trace_str(&s->trace, "mode", mode_name(mode));
+    ske_trace_str(&s->trace, "from", mode_name(from));
+    if (why)
+        ske_trace_str(&s->trace, "reason", why);
+    ske_trace_end(&s->trace);
+}
+
+/* ---- process management --------------------------------------------------------------- */
+
+static void child_exec(ske_t *s, part_t *p, int errpipe, char **envp) __attribute__((noreturn));
+
+static void child_exec(ske_t *s, part_t *p, int errpipe, char **envp)
+{
+    int n = p->cfg->n_ports;
+    /* Partitions live in their own process group: a terminal's Ctrl-C reaches the SKE
+     * only, which then stops them. They die with the SKE. */
+    setpgid(0, 0);
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    struct sigaction dfl = {.sa_handler = SIG_DFL};
+    sigaction(SIGINT, &dfl, NULL);
+    sigaction(SIGTERM, &dfl, NULL);
+    sigaction(SIGCHLD, &dfl, NULL);
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, NULL);
+    int devnull = open("/dev/null", O_RDONLY);
+    if (devnull >= 0) {
+        dup2(devnull, 0);
+        close(devnull);
+    }
+    /* Move every descriptor the partition gets above the target range, then into place:
+     * 3 = control block, 4.. = its ports, then the exec-error pipe; close the rest. */
+    int high[SKE_MAX_PORTS + 2];
+    const int base = 1024;
+    high[0] = fcntl(p->ctl_fd, F_DUPFD, base);
+    for (int k = 0; k < n; k++) {
+        const portmem_t *pm = &p->ports[k];
+        int src = p->cfg->ports[k].dir == SKE_DIR_DESTINATION ? pm->fd_ro : pm->fd;
+        high[1 + k] = fcntl(src, F_DUPFD, base);
+    }
+    high[1 + n] = fcntl(errpipe, F_DUPFD_CLOEXEC, base);
+    for (int k = 0; k <= n; k++)
+        dup2(high[k], 3 + k);
+    dup2(high[1 + n], 4 + n);
+    fcntl(4 + n, F_SETFD, FD_CLOEXEC);
+    close_range(5 + (unsigned)n, ~0U, 0);
+    if (getppid() == 1)
+        _exit(127); /* the SKE is already gone */
+    execve(p->cfg->executable, p->cfg->argv, envp);
+    int e = errno;
+    ssize_t w = write(4 + n, &e, sizeof e);
+    (void)w;
+    (void)s;
+    _exit(127);
+}
+
+static char **make_env(void)
+{
+    size_t n = 0;
+    while (environ[n])
+        n++;
+    char **envp = calloc(n + 2, sizeof *envp);
+    if (!envp)
+        return NULL;
+    size_t j = 0;
+    for (size_t i = 0; i < n; i++)
+        if (strncmp(environ[i], SKE_ENV_CTL_FD "=", strlen(SKE_ENV_CTL_FD) + 1) != 0)
+            envp[j++] = environ[i];
+    envp[j++] = SKE_ENV_CTL_FD "=3";
+    envp[j] = NULL;
+    return envp;
+}
+
+static int spawn(ske_t *s, part_t *p, char *err, size_t errlen)
+{
+    fill_ctl(s, p);
+    char **envp = make_env();
+    int pipefd[2];
+    if (!envp || pipe2(pipefd, O_CLOEXEC) != 0) {
+        free(envp);
+        snprintf(err, errlen, "cannot start partition '%s': %s", p->cfg->name, strerror(errno));
+        return SKE_E_SYS;
+    }
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid < 0) {
+        free(envp);
+        close(pipefd[0]);
+        close(pipefd[1]);
+        snprintf(err, errlen, "fork: %s", strerror(errno));
+        return SKE_E_SYS;
+    }
+    if (pid == 0)
+        child_exec(s, p, pipefd[1], envp);
+    free(envp);
+    close(pipefd[1]);
+    int e = 0;
+    ssize_t r;
+    do {
+        r = read(pipefd[0], &e, sizeof e);
+    } while (r < 0 && errno == EINTR);
+    close(pipefd[0]);
+    if (r == (ssize_t)sizeof e) {
+        waitpid(pid, NULL, 0);
+        snprintf(err, errlen, "cannot start partition '%s': %s: %s", p->cfg->name,
+                 p->cfg->executable, strerror(e));
+        return SKE_E_PARTITION;
+    }
+    p->pid = pid;
+    p->state = PS_RUNNING;
+    p->cpu_at_yield_ns = -1;
+    if (clock_getcpuclockid(pid, &p->cpu_clock) != 0)
+        p->cpu_clock = (clockid_t)-1;
+    /* Wait until the partition has attached and waits for its first grant, so that program
+     * loading is never charged to a window. */
+    int64_t t0 = ske_mono_ns();
+    while (!atomic_load(&p->ctl->ready)) {
+        int st;
+        pid_t w = waitpid(pid, &st, WNOHANG);
+        if (w == pid) {
+            p->state = WIFSIGNALED(st) ? PS_CRASHED : PS_EXITED;
+            p->exit_code = WIFSIGNALED(st) ? WTERMSIG(st) : WEXITSTATUS(st);
+            snprintf(err, errlen, "partition '%s' (%s) %s before attaching to the SKE (%s %d)",
+                     p->cfg->name, p->cfg->executable,
+                     WIFSIGNALED(st) ? "was killed" : "exited",
+                     WIFSIGNALED(st) ? "signal" : "status", p->exit_code);
+            return SKE_E_PARTITION;
+        }
+        if (ske_mono_ns() - t0 > READY_TIMEOUT_NS) {
+            kill(pid, SIGKILL);
+            waitpid(pid, NULL, 0);
+            p->state = PS_CRASHED;
+            snprintf(err, errlen, "partition '%s' did not attach within 10 s (is it linked "
+                     "with the APEX library?)", p->cfg->name);
+            return SKE_E_PARTITION;
+        }
+        if (s->stop_signal) {
+            snprintf(err, errlen, "stopped while starting partition '%s'", p->cfg->name);
+            return SKE_E_PARTITION;
+        }
+        struct timespec ts = {0, 1000000};
+        ske_futex_wait(&p->ctl->ready, 0, &ts);
+    }
+    return SKE_OK;
+}
+
+static int64_t cpu_now(const part_t *p)
+{
+    struct timespec ts;
+    if (p->cpu_clock == (clockid_t)-1 || clock_gettime(p->cpu_clock, &ts) != 0)
+        return -1;
+    return (int64_t)ts.tv_sec * 1000000000LL + ts.tv_nsec;
+}
+
+static void record_exit(ske_t *s, part_t *p, int status)
+{
+    p->state = WIFSIGNALED(status) ? PS_CRASHED : PS_EXITED;
+    p->exit_code = WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status);
+    p->pid = 0;
+    ske_trace_begin(&s->trace, s->now_ns, "ske", "partition_exit");
+    ske_trace_str(&s->trace, "partition", p->cfg->name);
+    if (WIFSIGNALED(status)) {
+        ske_trace_str(&s->trace, "status", "crashed");
+        ske_trace_str(&s->trace, "signal", sigabbrev_np(p->exit_code) ? sigabbrev_np(p->exit_code) : "?");
+    } else {
+        ske_trace_str(&s->trace, "status", "exited");
+        ske_trace_int(&s->trace, "code", p->exit_code);
+    }
+    ske_trace_end(&s->trace);
+}
+
+/* Reaps every partition that ended. */
+static void reap(ske_t *s)
+{
+    s->child_event = 0;
+    for (;;) {
+        int st;
+        pid_t w = waitpid(-1, &st, WNOHANG);
+        if (w <= 0)
+            return;
+        for (int i = 0; i < s->cfg->n_partitions; i++)
+            if (s->parts[i].pid == w && alive(&s->parts[i]))
+                record_exit(s, &s->parts[i], st);
+    }
+}
+
+static void kill_partition(part_t *p)
+{
+    if (p->pid > 0) {
+        kill(p->pid, SIGKILL);
+        waitpid(p->pid, NULL, 0);
+        p->pid = 0;
+    }
+}
+
+/* ---- one window ----------------------------------------------------------------------- */
+
+typedef enum { W_YIELD, W_OVERRUN, W_EXIT, W_STOP } wres_t;
+
+static void cpu_relax(void) { __asm__ __volatile__("pause" ::: "memory"); }
+
+static bool yielded(const part_t *p)
+{
+    return atomic_load_explicit(&p->ctl->yield_seq, memory_order_acquire) == p->grant_seq;
+}
+
+/* Waits for the partition to hand the CPU back. Emulated mode: the window's length is a
+ * budget of CPU time (computation takes no emulated time, but it may not take unbounded
+ * real time either). Real-time mode: the window ends at its wall-clock end. */
+static wres_t wait_yield(ske_t *s, part_t *p, int64_t budget_ns, int64_t end_mono_ns, int64_t cpu0)
+{
+    int64_t t0 = ske_mono_ns();
+    while (ske_mono_ns() - t0 < SPIN_NS) {
+        if (yielded(p))
+            return W_YIELD;
+        if (s->child_event || s->stop_signal)
+            break;
+        for (int i = 0; i < 32; i++)
+            cpu_relax();
+    }
+    for (;;) {
+        if (yielded(p))
+            return W_YIELD;
+        if (s->child_event) {
+            reap(s);
+            if (!alive(p))
+                return W_EXIT;
+        }
+        if (s->stop_signal)
+            return W_STOP;
+        int64_t now = ske_mono_ns();
+        int64_t wait_ns;
+        if (s->time_mode == SKE_TIME_REALTIME) {
+            wait_ns = end_mono_ns - now;
+            if (wait_ns <= 0)
+                return W_OVERRUN;
+        } else {
+            int64_t used = cpu0 >= 0 ? cpu_now(p) - cpu0 : now - t0;
+            if (used >= budget_ns)
+                return W_OVERRUN;
+            int64_t hang = budget_ns * HANG_FACTOR > HANG_MIN_NS ? budget_ns * HANG_FACTOR : HANG_MIN_NS;
+            if (now - t0 > hang)
+                return W_OVERRUN; /* blocked without using its CPU: the plan cannot wait */
+            wait_ns = budget_ns - used;
+            if (wait_ns > 10000000)
+                wait_ns = 10000000;
+            if (wait_ns < 50000)
+                wait_ns = 50000;
+        }
+        uint32_t v = atomic_load(&p->ctl->yield_seq);
+        if (v == p->grant_seq)
+            return W_YIELD;
+        struct timespec ts = {wait_ns / 1000000000LL, wait_ns % 1000000000LL};
+        ske_futex_wait(&p->ctl->yield_seq, v, &ts);
+    }
+}
+
+/* Moves the messages a source queuing port holds to the destination's queue, as the core
+ * software does at the end of the source's window (ARINC 653 Part 1, queuing mode). */
+static void transfer_queues(ske_t *s, part_t *p, int64_t t_ns)
+{
+    const ske_module_cfg_t *m = s->cfg;
+    for (int k = 0; k < p->cfg->n_ports; k++) {
+        const ske_port_cfg_t *pc = &p->cfg->ports[k];
+        if (pc->kind != SKE_PORT_QUEUING || pc->dir != SKE_DIR_SOURCE || pc->channel < 0)
+            continue;
+        const ske_channel_cfg_t *ch = &m->channels[pc->channel];
+        part_t *dp = &s->parts[ch->dst[0].partition];
+        const ske_port_cfg_t *dc = &dp->cfg->ports[ch->dst[0].port];
+        ske_queue_hdr_t *sq = p->ports[k].mem;
+        void *dq = dp->ports[ch->dst[0].port].mem;
+        ske_port_desc_t *dd = &dp->ctl->ports[ch->dst[0].port];
+        uint32_t stail = atomic_load(&sq->tail);
+        uint32_t n = ske_queue_count(sq, pc->max_nb, stail);
+        if (n == UINT32_MAX) {
+            /* The source wrote inconsistent indices into its own queue: drop its content. */
+            atomic_store(&sq->tail, atomic_load(&sq->head));
+            ske_trace_begin(&s->trace, t_ns, "ske", "port");
+            ske_trace_str(&s->trace, "event", "corrupt");
+            ske_trace_str(&s->trace, "partition", p->cfg->name);
+            ske_trace_str(&s->trace, "port", pc->name);
+            ske_trace_end(&s->trace);
+            continue;
+        }
+        uint8_t buf[1u << 20];
+        for (uint32_t i = 0; i < n; i++) {
+            uint32_t len;
+            int64_t mt;
+            ske_queue_peek(sq, pc->max_size, pc->max_nb, stail, buf, &len, &mt);
+            stail++;
+            uint32_t dtail = atomic_load(&dd->rx_tail);
+            if (ske_queue_count(dq, dc->max_nb, dtail) == UINT32_MAX) {
+                /* The destination corrupted its consumer index: resynchronise it. */
+                atomic_store(&dd->rx_tail, atomic_load(&((ske_queue_hdr_t *)dq)->head));
+                dtail = atomic_load(&dd->rx_tail);
+            }
+            if (ske_queue_push(dq, dc->max_size, dc->max_nb, dtail, buf, len, mt)) {
+                s->chan_messages[pc->channel]++;
+            } else {
+                atomic_fetch_add(&((ske_queue_hdr_t *)dq)->overflows, 1);
+                s->chan_overflows[pc->channel]++;
+                ske_trace_begin(&s->trace, t_ns, "ske", "port");
+                ske_trace_str(&s->trace, "event", "overflow");
+                ske_trace_str(&s->trace, "channel", ch->name);
+                ske_trace_str(&s->trace, "partition", dp->cfg->name);
+                ske_trace_str(&s->trace, "port", dc->name);
+                ske_trace_end(&s->trace);
+            }
+        }
+        atomic_store(&sq->tail, stail);
+    }
+}
+
+/* Copies the partition's events into the trace. The ring is written by the partition, so
+ * every field is checked; an event claiming a time outside the window is kept but marked. */
+static void drain_events(ske_t *s, part_t *p, int64_t win_start, int64_t win_end)
+{
+    ske_ctl_t *c = p->ctl;
+    uint32_t head = atomic_load_explicit(&c->ev_head, memory_order_acquire);
+    uint32_t tail = atomic_load(&c->ev_tail);
+    uint32_t n = head - tail;
+    if (n > SKE_EVENT_RING) {
+        atomic_store(&c->ev_tail, head);
+        return;
+    }
+    for (; tail != head; tail++) {
+        ske_event_t e = c->ev[tail % SKE_EVENT_RING];
+        int64_t t = e.t_ns;
+        bool suspect = t < win_start || t > win_end;
+        if (suspect)
+            t = win_start;
+        uint32_t len = e.len < SKE_EVENT_TEXT ? e.len : SKE_EVENT_TEXT;
+        switch (e.kind) {
+        case SKE_EV_MODE:
+            if (e.a < 0 || e.a > 3 || e.b < 0 || e.b > 3)
+                continue;
+            ske_trace_begin(&s->trace, t, p->cfg->name, "mode");
+            ske_trace_str(&s->trace, "partition", p->cfg->name);
+            ske_trace_str(&s->trace, "mode", mode_name((uint32_t)e.a));
+            ske_trace_str(&s->trace, "from", mode_name((uint32_t)e.b));
+            break;
+        case SKE_EV_PORT_VALIDITY:
+            if (e.a < 0 || e.a >= p->cfg->n_ports)
+                continue;
+            ske_trace_begin(&s->trace, t, p->cfg->name, "port");
+            ske_trace_str(&s->trace, "event", e.b ? "valid" : "invalid");
+            ske_trace_str(&s->trace, "partition", p->cfg->name);
+            ske_trace_str(&s->trace, "port", p->cfg->ports[e.a].name);
+            break;
+        case SKE_EV_APP_MESSAGE:
+            ske_trace_begin(&s->trace, t, p->cfg->name, "app_message");
+            ske_trace_int(&s->trace, "process", e.a);
+            ske_trace_strn(&s->trace, "text", e.text, len);
+            break;
+        case SKE_EV_PROCESS:
+            ske_trace_begin(&s->trace, t, p->cfg->name, "process");
+            ske_trace_int(&s->trace, "process", e.a);
+            ske_trace_strn(&s->trace, "name", e.text, strnlen(e.text, len));
+            ske_trace_str(&s->trace, "event", e.b == SKE_PROC_EV_START ? "start" : "stop");
+            break;
+        default:
+            continue;
+        }
+        if (suspect) {
+            ske_trace_bool(&s->trace, "suspect_time", true);
+            ske_trace_int(&s->trace, "reported_t_ns", e.t_ns);
+        }
+        ske_trace_end(&s->trace);
+    }
+    atomic_store(&c->ev_tail, head);
+    uint32_t dropped = atomic_exchange(&c->ev_dropped, 0);
+    if (dropped) {
+        ske_trace_begin(&s->trace, win_end, "ske", "events_dropped");
+        ske_trace_str(&s->trace, "partition", p->cfg->name);
+        ske_trace_int(&s->trace, "count", dropped);
+        ske_trace_end(&s->trace);
+    }
+}
+
+/* A partition asked for IDLE or a restart through SET_PARTITION_MODE. */
+static int handle_mode_request(ske_t *s, part_t *p, int64_t t, char *err, size_t errlen)
+{
+    uint32_t seq = atomic_load(&p->ctl->mode_request_seq);
+    if (seq == p->mode_request_seq)
+        return SKE_OK;
+    p->mode_request_seq = seq;
+    uint32_t req = atomic_load(&p->ctl->mode_request);
+    uint32_t cur = atomic_load(&p->ctl->mode);
+    if (req == SKE_MODE_IDLE) {
+        kill_partition(p);
+        p->state = PS_IDLE;
+        trace_mode(s, p, t, SKE_MODE_IDLE, cur, "SET_PARTITION_MODE");
+        return SKE_OK;
+    }
+    if (req == SKE_MODE_COLD_START || req == SKE_MODE_WARM_START) {
+        kill_partition(p);
+        trace_mode(s, p, t, req, cur, "SET_PARTITION_MODE");
+        p->start_condition = 1; /* PARTITION_RESTART */
+        p->initial_mode = req;
+        p->restarts++;
+        p->state = PS_NOT_STARTED;
+        return spawn(s, p, err, errlen);
+    }
+    return SKE_OK;
+}
+
+static int run_window(ske_t *s, int64_t frame, const ske_window_cfg_t *w, char *err, size_t errlen)
+{
+    part_t *p = &s->parts[w->partition];
+    int64_t start = frame * s->cfg->major_frame_ns + w->offset_ns;
+    int64_t end = start + w->duration_ns;
+    s->now_ns = start;
+    bool rt = s->time_mode == SKE_TIME_REALTIME;
+    int64_t start_mono = s->epoch_mono_ns + start;
+    int64_t late = 0;
+    if (rt) {
+        struct timespec ts = {start_mono / 1000000000LL, start_mono % 1000000000LL};
+        while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR) {
+            if (s->stop_signal)
+                return SKE_OK;
+            if (s->child_event)
+                reap(s);
+        }
+        late = ske_mono_ns() - start_mono;
+    }
+    if (s->child_event)
+        reap(s);
+
+    ske_trace_begin(&s->trace, start, "ske", "window_start");
+    ske_trace_str(&s->trace, "partition", p->cfg->name);
+    ske_trace_int(&s->trace, "window", w->id);
+    ske_trace_int(&s->trace, "frame", frame);
+    if (!alive(p))
+        ske_trace_str(&s->trace, "partition_state", state_name(p->state));
+    if (rt)
+        ske_trace_int(&s->trace, "late_ns", late);
+    ske_trace_end(&s->trace);
+
+    wres_t r = W_EXIT;
+    bool granted = false;
+    if (alive(p)) {
+        granted = true;
+        int64_t cpu0 = cpu_now(p);
+        if (p->cpu_at_yield_ns >= 0 && cpu0 >= 0 && cpu0 - p->cpu_at_yield_ns > p->cpu_outside_max_ns)
+            p->cpu_outside_max_ns = cpu0 - p->cpu_at_yield_ns;
+        if (p->state == PS_STOPPED) {
+            kill(p->pid, SIGCONT);
+            p->state = PS_RUNNING;
+        }
+        atomic_store(&p->ctl->win_start_ns, start);
+        atomic_store(&p->ctl->win_end_ns, end);
+        p->grant_seq++;
+        atomic_store_explicit(&p->ctl->grant_seq, p->grant_seq, memory_order_release);
+        ske_futex_wake(&p->ctl->grant_seq);
+        p->windows++;
+        r = wait_yield(s, p, w->duration_ns, s->epoch_mono_ns + end, cpu0);
+        int64_t cpu1 = cpu_now(p);
+        if (r == W_OVERRUN) {
+            kill(p->pid, SIGSTOP);
+            int st;
+            pid_t wp = waitpid(p->pid, &st, WUNTRACED);
+            if (wp == p->pid && !WIFSTOPPED(st)) {
+                record_exit(s, p, st);
+                r = W_EXIT;
+            } else {
+                /* It may have yielded in the instant before the stop took effect. */
+                if (yielded(p)) {
+                    kill(p->pid, SIGCONT);
+                    r = W_YIELD;
+                } else {
+                    p->state = PS_STOPPED;
+                    p->overruns++;
+                }
+            }
+        }
+        if (cpu0 >= 0 && cpu1 >= 0)
+            p->cpu_ns += cpu1 - cpu0;
+        p->cpu_at_yield_ns = r == W_YIELD ? cpu1 : -1;
+        if (r == W_YIELD) {
+            int64_t wake = atomic_load(&p->ctl->wake_mono_ns);
+            int64_t yield = atomic_load(&p->ctl->yield_mono_ns);
+            if (rt) {
+                int64_t j = wake - start_mono;
+                if (j > -1000000000LL && j < 1000000000LL)
+                    ske_samples_add(&s->jitter_ns, j < 0 ? 0 : j);
+            } else if (s->prev_yield_mono_ns > 0) {
+                int64_t sw = wake - s->prev_yield_mono_ns;
+                if (sw > 0 && sw < 1000000000LL)
+                    ske_samples_add(&s->switch_ns, sw);
+            }
+            s->prev_yield_mono_ns = yield;
+        } else {
+            s->prev_yield_mono_ns = 0;
+        }
+    } else {
+        s->prev_yield_mono_ns = 0;
+    }
+
+    if (r == W_OVERRUN) {
+        ske_trace_begin(&s->trace, end, "ske", "overrun");
+        ske_trace_str(&s->trace, "partition", p->cfg->name);
+        ske_trace_int(&s->trace, "window", w->id);
+        ske_trace_int(&s->trace, "frame", frame);
+        ske_trace_int(&s->trace, "budget_ns", w->duration_ns);
+        ske_trace_str(&s->trace, "action", "stopped");
+        ske_trace_end(&s->trace);
+    }
+    if (granted && p->ctl) {
+        drain_events(s, p, start, end);
+        transfer_queues(s, p, end);
+    }
+    ske_trace_begin(&s->trace, end, "ske", "window_end");
+    ske_trace_str(&s->trace, "partition", p->cfg->name);
+    ske_trace_int(&s->trace, "window", w->id);
+    ske_trace_int(&s->trace, "frame", frame);
+    if (granted) {
+        ske_trace_bool(&s->trace, "yielded", r == W_YIELD);
+        if (r == W_YIELD && !rt) {
+            int64_t yt = atomic_load(&p->ctl->yield_t_ns);
+            if (yt >= start && yt <= end)
+                ske_trace_int(&s->trace, "yield_t_ns", yt);
+        }
+    }
+    ske_trace_end(&s->trace);
+    if (r == W_YIELD && alive(p))
+        return handle_mode_request(s, p, end, err, errlen);
+    return SKE_OK;
+}
+
+/* ---- life cycle ----------------------------------------------------------------------- */
+
+int ske_create(const ske_module_cfg_t *cfg, const ske_run_opts_t *opts, ske_t **out, char *err,
+               size_t errlen)
+{
+    *out = NULL;
+    ske_t *s = calloc(1, sizeof *s);
+    if (!s) {
+        snprintf(err, errlen, "out of memory");
+        return SKE_E_NOMEM;
+    }
+    s->cfg = cfg;
+    s->opts = *opts;
+    s->time_mode = opts->time_mode >= 0 ? (ske_time_mode_t)opts->time_mode : cfg->time_mode;
+    snprintf(s->node, sizeof s->node, "%s", opts->node ? opts->node : cfg->node);
+    ske_samples_init(&s->switch_ns, SAMPLE_LIMIT);
+    ske_samples_init(&s->jitter_ns, SAMPLE_LIMIT);
+    snprintf(s->exit_reason, sizeof s->exit_reason, "frames");
+    for (int i = 0; i < cfg->n_partitions; i++) {
+        part_t *p = &s->parts[i];
+        p->cfg = &cfg->partitions[i];
+        p->index = i;
+        p->state = PS_NOT_STARTED;
+        p->ctl_fd = -1;
+        p->start_condition = 0; /* NORMAL_START */
+        p->initial_mode = SKE_MODE_COLD_START;
+        for (int k = 0; k < SKE_MAX_PORTS; k++)
+            p->ports[k].fd = p->ports[k].fd_ro = -1;
+    }
+    int rc = setup_ports(s, err, errlen);
+    if (rc != SKE_OK)
+        goto fail;
+    for (int i = 0; i < cfg->n_partitions; i++) {
+        part_t *p = &s->parts[i];
+        char name[64];
+        snprintf(name, sizeof name, "ima-ctl-%s", p->cfg->name);
+        void *mem;
+        p->ctl_fd = memobj(name, sizeof(ske_ctl_t), &mem);
+        if (p->ctl_fd < 0) {
+            snprintf(err, errlen, "control block: %s", strerror(-p->ctl_fd));
+            rc = SKE_E_SYS;
+            goto fail;
+        }
+        p->ctl = mem;
+    }
+    if (ske_trace_open(&s->trace, opts->trace_path, s->node) != 0) {
+        snprintf(err, errlen, "cannot write the trace %s: %s", opts->trace_path, strerror(errno));
+        rc = SKE_E_IO;
+        goto fail;
+    }
+    *out = s;
+    return SKE_OK;
+fail:
+    ske_destroy(s);
+    return rc;
+}
+
+static void trace_schedule(ske_t *s)
+{
+    const ske_module_cfg_t *m = s->cfg;
+    ske_trace_begin(&s->trace, 0, "ske", "module_start");
+    ske_trace_str(&s->trace, "module", m->module_name);
+    ske_trace_str(&s->trace, "time_mode", s->time_mode == SKE_TIME_REALTIME ? "realtime" : "emulated");
+    ske_trace_int(&s->trace, "major_frame_ns", m->major_frame_ns);
+    if (s->trace.f) {
+        fputs(",\"windows\":[", s->trace.f);
+        for (int i = 0; i < m->n_windows; i++) {
+            const ske_window_cfg_t *w = &m->windows[i];
+            fprintf(s->trace.f, "%s{\"window\":%d,\"partition\":", i ? "," : "", w->id);
+            ske_json_escape(s->trace.f, m->partitions[w->partition].name,
+                            strlen(m->partitions[w->partition].name));
+            fprintf(s->trace.f, ",\"offset_ns\":%" PRId64 ",\"duration_ns\":%" PRId64 "}",
+                    w->offset_ns, w->duration_ns);
+        }
+        fputc(']', s->trace.f);
+    }
+    ske_trace_end(&s->trace);
+    for (int i = 0; i < m->n_partitions; i++)
+        trace_mode(s, &s->parts[i], 0, SKE_MODE_COLD_START, SKE_MODE_IDLE, "power-on");
+}
+
+static void write_stats(ske_t *s, double wall_s)
+{
+    if (!s->opts.stats_path)
+        return;
+    FILE *f = fopen(s->opts.stats_path, "w");
+    if (!f)
+        return;
+    const ske_module_cfg_t *m = s->cfg;
+    fputs("{\"module\":", f);
+    ske_json_escape(f, m->module_name, strlen(m->module_name));
+    fputs(",\"node\":", f);
+    ske_json_escape(f, s->node, strlen(s->node));
+    fprintf(f, ",\"mode\":\"%s\",\"major_frame_ns\":%" PRId64 ",\"frames\":%" PRId64
+               ",\"emulated_ns\":%" PRId64 ",\"wall_s\":%.6f,\"exit_reason\":\"%s\",\"partitions\":[",
+            s->time_mode == SKE_TIME_REALTIME ? "realtime" : "emulated", m->major_frame_ns,
+            s->frames_done, s->frames_done * m->major_frame_ns, wall_s, s->exit_reason);
+    for (int i = 0; i < m->n_partitions; i++) {
+        const part_t *p = &s->parts[i];
+        int64_t per_frame = 0;
+        int nwin = 0;
+        for (int k = 0; k < m->n_windows; k++)
+            if (m->windows[k].partition == i) {
+                per_frame += m->windows[k].duration_ns;
+                nwin++;
+            }
+        fprintf(f, "%s{\"id\":%d,\"name\":", i ? "," : "", p->cfg->id);
+        ske_json_escape(f, p->cfg->name, strlen(p->cfg->name));
+        fprintf(f, ",\"windows_per_frame\":%d,\"window_ns_per_frame\":%" PRId64
+                   ",\"windows\":%llu,\"cpu_ns\":%" PRId64 ",\"overruns\":%llu,\"restarts\":%llu"
+                   ",\"state\":\"%s\",\"exit_status\":",
+                nwin, per_frame, (unsigned long long)p->windows, p->cpu_ns,
+                (unsigned long long)p->overruns, (unsigned long long)p->restarts,
+                state_name(p->state));
+        if (p->state == PS_EXITED || p->state == PS_CRASHED)
+            fprintf(f, "%d", p->exit_code);
+        else
+            fputs("null", f);
+        fprintf(f, ",\"cpu_outside_windows_ns_max\":%" PRId64 "}", p->cpu_outside_max_ns);
+    }
+    fputs("],\"window_switch_us\":", f);
+    ske_samples_json_us(&s->switch_ns, f);
+    fputs(",\"jitter_us\":", f);
+    ske_samples_json_us(&s->jitter_ns, f);
+    fputs(",\"channels\":[", f);
+    for (int c = 0; c < m->n_channels; c++) {
+        const ske_channel_cfg_t *ch = &m->channels[c];
+        uint64_t msgs = s->chan_messages[c];
+        if (ch->kind == SKE_PORT_SAMPLING) {
+            const ske_sampling_hdr_t *h = s->parts[ch->src.partition].ports[ch->src.port].mem;
+            msgs = atomic_load(&h->seq);
+        }
+        fprintf(f, "%s{\"id\":%d,\"name\":", c ? "," : "", ch->id);
+        ske_json_escape(f, ch->name, strlen(ch->name));
+        fprintf(f, ",\"kind\":\"%s\",\"messages\":%llu,\"overflows\":%llu}",
+                ch->kind == SKE_PORT_SAMPLING ? "sampling" : "queuing", (unsigned long long)msgs,
+                (unsigned long long)s->chan_overflows[c]);
+    }
+    fputs("]}\n", f);
+    fclose(f);
+}
+
+int ske_run(ske_t *s, char *err, size_t errlen)
+{
+    const ske_module_cfg_t *m = s->cfg;
+    int rc = SKE_OK;
+    s->start_mono_ns = ske_mono_ns();
+    s->epoch_mono_ns = s->start_mono_ns; /* refined below for real-time mode */
+    for (int i = 0; i < m->n_partitions && rc == SKE_OK; i++)
+        rc = spawn(s, &s->parts[i], err, errlen);
+    if (rc != SKE_OK) {
+        snprintf(s->exit_reason, sizeof s->exit_reason, s->stop_signal ? "signal" : "error");
+        goto done;
+    }
+    /* Module time 0 is now (plus a little margin in real time so the first window starts
+     * on time); partitions read the epoch from their control block at each grant. */
+    s->epoch_mono_ns = ske_mono_ns() + (s->time_mode == SKE_TIME_REALTIME ? 2000000 : 0);
+    for (int i = 0; i < m->n_partitions; i++)
+        s->parts[i].ctl->epoch_mono_ns = s->epoch_mono_ns;
+    trace_schedule(s);
+    for (int64_t frame = 0; s->opts.frames < 0 || frame < s->opts.frames; frame++) {
+        for (int wi = 0; wi < m->n_windows; wi++) {
+            if (s->stop_signal)
+                break;
+            rc = run_window(s, frame, &m->windows[wi], err, errlen);
+            if (rc != SKE_OK)
+                break;
+        }
+        if (s->stop_signal || rc != SKE_OK)
+            break;
+        s->frames_done = frame + 1;
+        ske_trace_maybe_flush(&s->trace, ske_mono_ns());
+    }
+    if (rc != SKE_OK)
+        snprintf(s->exit_reason, sizeof s->exit_reason, "error");
+    else if (s->stop_signal)
+        snprintf(s->exit_reason, sizeof s->exit_reason, "signal");
+done:
+    for (int i = 0; i < m->n_partitions; i++)
+        kill_partition(&s->parts[i]);
+    ske_trace_begin(&s->trace, s->frames_done * m->major_frame_ns, "ske", "module_stop");
+    ske_trace_int(&s->trace, "frames", s->frames_done);
+    ske_trace_str(&s->trace, "reason", s->exit_reason);
+    ske_trace_end(&s->trace);
+    ske_trace_close(&s->trace);
+    write_stats(s, (double)(ske_mono_ns() - s->start_mono_ns) / 1e9);
+    return rc;
+}
+
+void ske_destroy(ske_t *s)
+{
+    if (!s)
+        return;
+    for (int i = 0; i < SKE_MAX_PARTITIONS; i++) {
+        part_t *p = &s->parts[i];
+        if (!p->cfg)
+            continue;
+        kill_partition(p);
+        for (int k = 0; k < p->cfg->n_ports; k++) {
+            portmem_t *pm = &p->ports[k];
+            if (pm->fd >= 0) {
+                munmap(pm->mem, pm->size);
+                close(pm->fd);
+            }
+            if (pm->fd_ro >= 0)
+                close(pm->fd_ro);
+        }
+        if (p->ctl)
+            munmap(p->ctl, sizeof(ske_ctl_t));
+        if (p->ctl_fd >= 0)
+            close(p->ctl_fd);
+    }
+    ske_trace_close(&s->trace);
+    ske_samples_free(&s->switch_ns);
+    ske_samples_free(&s->jitter_ns);
+    free(s);
+}

@@ -3,6 +3,7 @@
  * runs the cyclic plan by granting the CPU to one partition at a time, stops a partition
  * that keeps it past its window, moves queuing messages, and records all of it. */
 #include "ske/ske.h"
+#include "ske/plan.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -27,6 +28,8 @@ extern char **environ;
 #define HANG_FACTOR 20 /* emulated mode: a window may take this many times its length in wall */
 #define HANG_MIN_NS 2000000000LL /* time (at least 2 s) while using no CPU before it is cut */
 #define SAMPLE_LIMIT 2000000
+#define RT_SPIN_NS 200000 /* real-time mode: spin this long before a window starts */
+#define SYSTEM_MESSAGE_MAX (1u << 20) /* the largest MaxMessageSize the schema accepts */
 
 typedef enum {
     PS_NOT_STARTED,
@@ -82,6 +85,7 @@ struct ske {
     int64_t frames_done;
     int64_t now_ns; /* module time of the current window start */
     int64_t prev_yield_mono_ns; /* the previous window's yield, for the switch figure */
+    uint8_t *xfer; /* one message, for queue transfers */
     volatile sig_atomic_t stop_signal;
     volatile sig_atomic_t child_event;
     char exit_reason[16];
@@ -111,6 +115,8 @@ static bool alive(const part_t *p) { return p->state == PS_RUNNING || p->state =
 void ske_request_stop(ske_t *ske, int signo) { ske->stop_signal = signo; }
 void ske_notify_child(ske_t *ske) { ske->child_event = 1; }
 int ske_stop_signal(const ske_t *ske) { return ske->stop_signal; }
+
+static void cpu_relax(void) { __asm__ __volatile__("pause" ::: "memory"); }
 
 /* ---- memory objects ------------------------------------------------------------------- */
 
@@ -444,7 +450,6 @@ static void kill_partition(part_t *p)
 
 typedef enum { W_YIELD, W_OVERRUN, W_EXIT, W_STOP } wres_t;
 
-static void cpu_relax(void) { __asm__ __volatile__("pause" ::: "memory"); }
 
 static bool yielded(const part_t *p)
 {
@@ -457,13 +462,13 @@ static bool yielded(const part_t *p)
 static wres_t wait_yield(ske_t *s, part_t *p, int64_t budget_ns, int64_t end_mono_ns, int64_t cpu0)
 {
     int64_t t0 = ske_mono_ns();
-    while (ske_mono_ns() - t0 < SPIN_NS) {
+    /* Most windows of a light partition end within microseconds: notice that at once. */
+    for (uint32_t i = 1;; i++) {
         if (yielded(p))
             return W_YIELD;
-        if (s->child_event || s->stop_signal)
+        cpu_relax();
+        if ((i & 63) == 0 && (ske_mono_ns() - t0 > SPIN_NS || s->child_event || s->stop_signal))
             break;
-        for (int i = 0; i < 32; i++)
-            cpu_relax();
     }
     for (;;) {
         if (yielded(p))
@@ -529,7 +534,7 @@ static void transfer_queues(ske_t *s, part_t *p, int64_t t_ns)
             ske_trace_end(&s->trace);
             continue;
         }
-        uint8_t buf[1u << 20];
+        uint8_t *buf = s->xfer;
         for (uint32_t i = 0; i < n; i++) {
             uint32_t len;
             int64_t mt;
@@ -651,23 +656,31 @@ static int handle_mode_request(ske_t *s, part_t *p, int64_t t, char *err, size_t
     return SKE_OK;
 }
 
-static int run_window(ske_t *s, int64_t frame, const ske_window_cfg_t *w, char *err, size_t errlen)
+static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen)
 {
+    const ske_window_cfg_t *w = slot->window;
     part_t *p = &s->parts[w->partition];
-    int64_t start = frame * s->cfg->major_frame_ns + w->offset_ns;
-    int64_t end = start + w->duration_ns;
+    int64_t frame = slot->frame;
+    int64_t start = slot->start_ns;
+    int64_t end = slot->end_ns;
     s->now_ns = start;
     bool rt = s->time_mode == SKE_TIME_REALTIME;
     int64_t start_mono = s->epoch_mono_ns + start;
     int64_t late = 0;
     if (rt) {
-        struct timespec ts = {start_mono / 1000000000LL, start_mono % 1000000000LL};
-        while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR) {
+        /* Sleep until shortly before the window, then spin to its exact start: a sleeping
+         * thread wakes tens of microseconds late, a spinning one within a microsecond. */
+        int64_t wake = start_mono - RT_SPIN_NS;
+        struct timespec ts = {wake / 1000000000LL, wake % 1000000000LL};
+        while (ske_mono_ns() < wake &&
+               clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR) {
             if (s->stop_signal)
                 return SKE_OK;
             if (s->child_event)
                 reap(s);
         }
+        while (ske_mono_ns() < start_mono)
+            cpu_relax();
         late = ske_mono_ns() - start_mono;
     }
     if (s->child_event)
@@ -789,6 +802,12 @@ int ske_create(const ske_module_cfg_t *cfg, const ske_run_opts_t *opts, ske_t **
     s->opts = *opts;
     s->time_mode = opts->time_mode >= 0 ? (ske_time_mode_t)opts->time_mode : cfg->time_mode;
     snprintf(s->node, sizeof s->node, "%s", opts->node ? opts->node : cfg->node);
+    s->xfer = malloc(SYSTEM_MESSAGE_MAX);
+    if (!s->xfer) {
+        free(s);
+        snprintf(err, errlen, "out of memory");
+        return SKE_E_NOMEM;
+    }
     ske_samples_init(&s->switch_ns, SAMPLE_LIMIT);
     ske_samples_init(&s->jitter_ns, SAMPLE_LIMIT);
     snprintf(s->exit_reason, sizeof s->exit_reason, "frames");
@@ -873,13 +892,8 @@ static void write_stats(ske_t *s, double wall_s)
             s->frames_done, s->frames_done * m->major_frame_ns, wall_s, s->exit_reason);
     for (int i = 0; i < m->n_partitions; i++) {
         const part_t *p = &s->parts[i];
-        int64_t per_frame = 0;
-        int nwin = 0;
-        for (int k = 0; k < m->n_windows; k++)
-            if (m->windows[k].partition == i) {
-                per_frame += m->windows[k].duration_ns;
-                nwin++;
-            }
+        int64_t per_frame = ske_plan_partition_ns(m, i);
+        int nwin = p->cfg->n_windows;
         fprintf(f, "%s{\"id\":%d,\"name\":", i ? "," : "", p->cfg->id);
         ske_json_escape(f, p->cfg->name, strlen(p->cfg->name));
         fprintf(f, ",\"windows_per_frame\":%d,\"window_ns_per_frame\":%" PRId64
@@ -921,6 +935,8 @@ int ske_run(ske_t *s, char *err, size_t errlen)
     const ske_module_cfg_t *m = s->cfg;
     int rc = SKE_OK;
     s->start_mono_ns = ske_mono_ns();
+    if (s->time_mode == SKE_TIME_REALTIME)
+        prctl(PR_SET_TIMERSLACK, 1UL); /* the default 50 µs slack would be window jitter */
     s->epoch_mono_ns = s->start_mono_ns; /* refined below for real-time mode */
     for (int i = 0; i < m->n_partitions && rc == SKE_OK; i++)
         rc = spawn(s, &s->parts[i], err, errlen);
@@ -934,18 +950,18 @@ int ske_run(ske_t *s, char *err, size_t errlen)
     for (int i = 0; i < m->n_partitions; i++)
         s->parts[i].ctl->epoch_mono_ns = s->epoch_mono_ns;
     trace_schedule(s);
-    for (int64_t frame = 0; s->opts.frames < 0 || frame < s->opts.frames; frame++) {
-        for (int wi = 0; wi < m->n_windows; wi++) {
-            if (s->stop_signal)
-                break;
-            rc = run_window(s, frame, &m->windows[wi], err, errlen);
-            if (rc != SKE_OK)
-                break;
-        }
-        if (s->stop_signal || rc != SKE_OK)
+    ske_slot_t slot;
+    for (ske_plan_first(m, &slot); s->opts.frames < 0 || slot.frame < s->opts.frames;
+         ske_plan_next(m, &slot)) {
+        if (s->stop_signal)
             break;
-        s->frames_done = frame + 1;
-        ske_trace_maybe_flush(&s->trace, ske_mono_ns());
+        rc = run_window(s, &slot, err, errlen);
+        if (rc != SKE_OK)
+            break;
+        if (slot.index == m->n_windows - 1) {
+            s->frames_done = slot.frame + 1;
+            ske_trace_maybe_flush(&s->trace, ske_mono_ns());
+        }
     }
     if (rc != SKE_OK)
         snprintf(s->exit_reason, sizeof s->exit_reason, "error");
@@ -989,5 +1005,6 @@ void ske_destroy(ske_t *s)
     ske_trace_close(&s->trace);
     ske_samples_free(&s->switch_ns);
     ske_samples_free(&s->jitter_ns);
+    free(s->xfer);
     free(s);
 }

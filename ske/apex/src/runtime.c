@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <sys/prctl.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -82,6 +83,8 @@ __attribute__((constructor)) static void apex_attach(void)
     if (rt->ctl->magic != SKE_ABI_MAGIC || rt->ctl->version != SKE_ABI_VERSION)
         fatal("apex: the SKE speaks another version of the partition interface");
     rt->realtime = rt->ctl->time_mode == SKE_TIME_REALTIME;
+    if (rt->realtime)
+        prctl(PR_SET_TIMERSLACK, 1UL); /* time-outs inside a window wake on time */
     rt->mode = (OPERATING_MODE_TYPE)rt->ctl->initial_mode;
     rt->seen_grant = 0;
     atomic_store(&rt->ctl->ready, 1);

@@ -295,6 +295,52 @@ def run_lines(stats: Mapping[str, Any]) -> list[str]:
     return lines
 
 
+_TIMELINE_STYLES = ("cyan", "magenta", "green", "yellow", "blue", "red", "bright_cyan",
+                    "bright_magenta")
+
+
+def timeline(stats: Mapping[str, Any], width: int = 60) -> list[tuple[str, str]]:
+    """The major frame as one row of cells: [(character, partition name or ""), ...].
+
+    Each of `width` cells covers major_frame/width; a cell shows the partition whose window
+    covers most of it (its initial), "·" when no window does.
+    """
+    maf = stats.get("major_frame_ns") or 0
+    windows = stats.get("windows") or []
+    if not maf or not windows:
+        return []
+    cells = []
+    for i in range(width):
+        lo, hi = maf * i / width, maf * (i + 1) / width
+        best, best_cover = "", 0.0
+        for w in windows:
+            start, end = w["offset_ns"], w["offset_ns"] + w["duration_ns"]
+            cover = min(hi, end) - max(lo, start)
+            if cover > best_cover:
+                best, best_cover = w["partition"], cover
+        cells.append(((best[:1].upper() or "?") if best else "·", best))
+    return cells
+
+
+def _timeline_text(stats: Mapping[str, Any], width: int = 52):
+    from rich.text import Text
+
+    cells = timeline(stats, width)
+    if not cells:
+        return None
+    names = [p.get("name") for p in stats.get("partitions") or []]
+    style = {n: _TIMELINE_STYLES[i % len(_TIMELINE_STYLES)] for i, n in enumerate(names)}
+    text = Text("Major frame  |")
+    for ch, name in cells:
+        text.append(ch, style=f"bold {style.get(name, '')}" if name else "dim")
+    maf_ms = stats["major_frame_ns"] / 1e6
+    text.append(f"| {maf_ms:g} ms\n")
+    text.append("             ")
+    for i, n in enumerate(names):
+        text.append(("  " if i else " ") + f"{(n or '?')[:1].upper()}={n}", style=style.get(n, ""))
+    return text
+
+
 def format_summary(stats: Mapping[str, Any]):
     """The schedule summary of one ima-ske run as a rich renderable."""
     from rich import box
@@ -349,7 +395,11 @@ def format_summary(stats: Mapping[str, Any]):
             Text(*_state(p)),
         )
 
-    items: list = [parts, *(Text(line) for line in run_lines(stats))]
+    items: list = [parts]
+    bar = _timeline_text(stats)
+    if bar is not None:
+        items.append(bar)
+    items += [Text(line) for line in run_lines(stats)]
     channels = stats.get("channels") or []
     if channels:
         table = Table(

@@ -908,6 +908,14 @@ static void write_stats(ske_t *s, double wall_s)
             fputs("null", f);
         fprintf(f, ",\"cpu_outside_windows_ns_max\":%" PRId64 "}", p->cpu_outside_max_ns);
     }
+    fputs("],\"windows\":[", f);
+    for (int i = 0; i < m->n_windows; i++) {
+        const ske_window_cfg_t *w = &m->windows[i];
+        fprintf(f, "%s{\"window\":%d,\"partition\":", i ? "," : "", w->id);
+        ske_json_escape(f, m->partitions[w->partition].name, strlen(m->partitions[w->partition].name));
+        fprintf(f, ",\"offset_ns\":%" PRId64 ",\"duration_ns\":%" PRId64 "}", w->offset_ns,
+                w->duration_ns);
+    }
     fputs("],\"window_switch_us\":", f);
     ske_samples_json_us(&s->switch_ns, f);
     fputs(",\"jitter_us\":", f);

@@ -141,9 +141,24 @@ def test_other_exceptions_are_not_caught(monkeypatch):
         cli.main(["demo"])
 
 
-def test_bench_ske_reports_not_implemented_as_one_line(capsys):
-    assert cli.main(["bench", "ske"]) == 1
-    assert capsys.readouterr().err == "ima: error: ima bench ske: not implemented yet\n"
+def test_bench_ske_error_is_one_line(capsys, monkeypatch):
+    from ima.bench import ske as bench_ske
+    from ima.errors import ImaError
+
+    def broken(frames=None, progress=None):
+        raise ImaError("ima-ske failed on trivial.xml (exit code 1)")
+
+    monkeypatch.setattr(bench_ske, "measure", broken)
+    assert cli.main(["bench", "ske", "--json"]) == 1
+    assert capsys.readouterr().err.endswith("ima: error: ima-ske failed on trivial.xml (exit code 1)\n")
+
+
+def test_bench_targets_are_judged_in_the_right_direction():
+    from ima.bench.ske import _meets
+
+    assert _meets(19.9, "<=", 20.0) and not _meets(20.1, "<=", 20.0)
+    assert _meets(5000.0, ">=", 5000.0) and not _meets(4999.0, ">=", 5000.0)
+    assert _meets(None, "<=", 1.0) is None
 
 
 def test_ctrl_c_ends_the_process_by_sigint_without_traceback():

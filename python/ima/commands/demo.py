@@ -4,6 +4,9 @@
 from __future__ import annotations
 
 import argparse
+import json
+import tempfile
+from pathlib import Path
 
 from ima import paths, ske
 from ima.commands.run import exit_code, positive_int
@@ -41,14 +44,36 @@ def run(args: argparse.Namespace) -> int:
         f"IMA Testbed demo: {module.relative_to(paths.repo_root())}, "
         f"{args.frames} major frames, emulated time"
     )
-    try:
-        returncode, stats = ske.run_module(module, frames=args.frames)
-    except ske.SkeInterrupted as exc:
-        if exc.stats:
-            ske.print_summary(exc.stats, console)
-        raise
+    with tempfile.TemporaryDirectory(prefix="ima-demo-") as tmp:
+        trace = Path(tmp) / "trace.jsonl"
+        try:
+            returncode, stats = ske.run_module(module, frames=args.frames, trace=trace)
+        except ske.SkeInterrupted as exc:
+            if exc.stats:
+                ske.print_summary(exc.stats, console)
+            raise
+        reports = last_reports(trace)
     if stats:
         ske.print_summary(stats, console)
+    if reports:
+        console.print("What the partitions last reported (REPORT_APPLICATION_MESSAGE):")
+        for src, (t_ns, text) in reports.items():
+            console.print(f"  {t_ns / 1e9:8.3f} s  {src:10} {text}", markup=False, highlight=False)
     elif returncode != ske.EXIT_CONFIG_ERROR:
         raise ImaError(f"ima-ske wrote no statistics (exit code {returncode})")
     return exit_code(returncode)
+
+
+def last_reports(trace: Path) -> dict[str, tuple[int, str]]:
+    """The last application message of each partition in a trace: {partition: (t_ns, text)}."""
+    reports: dict[str, tuple[int, str]] = {}
+    if not trace.exists():
+        return reports
+    with trace.open() as f:
+        for line in f:
+            if '"app_message"' not in line:
+                continue
+            event = json.loads(line)
+            if event.get("kind") == "app_message":
+                reports[event["src"]] = (event["t_ns"], event.get("text", ""))
+    return reports

@@ -1,0 +1,28 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The schedule timeline drawn in the run summary."""
+
+from ima.ske import timeline
+
+STATS = {
+    "major_frame_ns": 50_000_000,
+    "windows": [
+        {"window": 1, "partition": "producer", "offset_ns": 0, "duration_ns": 10_000_000},
+        {"window": 2, "partition": "consumer", "offset_ns": 10_000_000, "duration_ns": 12_000_000},
+        {"window": 5, "partition": "monitor", "offset_ns": 38_000_000, "duration_ns": 8_000_000},
+    ],
+}
+
+
+def test_one_cell_per_millisecond_shows_each_window_where_it_is():
+    row = "".join(ch for ch, _ in timeline(STATS, width=50))
+    assert row == "P" * 10 + "C" * 12 + "·" * 16 + "M" * 8 + "·" * 4
+
+
+def test_a_cell_goes_to_the_window_covering_most_of_it():
+    cells = timeline(STATS, width=5)  # 10 ms per cell
+    assert [name for _, name in cells] == ["producer", "consumer", "consumer", "monitor", "monitor"]
+
+
+def test_no_windows_no_timeline():
+    assert timeline({"major_frame_ns": 50_000_000}) == []
+    assert timeline({}) == []

@@ -237,8 +237,16 @@ static void fill_ctl(ske_t *s, part_t *p)
         d->fd = 4 + k; /* the child's descriptor numbers: 3 is the control block */
         d->map_size = (uint32_t)p->ports[k].size;
         d->channel = pc->channel >= 0 ? (uint32_t)s->cfg->channels[pc->channel].id : 0;
-        atomic_store(&d->rx_tail, 0);
-        atomic_store(&d->overflow_ack, 0);
+        /* A (re)started partition finds its destination queues empty (its ports are
+         * created anew), whatever the queue memory still holds from before. */
+        uint32_t head = 0, overflows = 0;
+        if (pc->kind == SKE_PORT_QUEUING && pc->dir == SKE_DIR_DESTINATION && p->ports[k].mem) {
+            const ske_queue_hdr_t *q = p->ports[k].mem;
+            head = atomic_load(&q->head);
+            overflows = atomic_load(&q->overflows);
+        }
+        atomic_store(&d->rx_tail, head);
+        atomic_store(&d->overflow_ack, overflows);
     }
     atomic_store(&c->mode, p->initial_mode);
     p->grant_seq = 0;

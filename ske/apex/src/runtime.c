@@ -113,8 +113,12 @@ void apex__sync(void)
         take_grant(); /* we were stopped after an overrun and continued in a new window */
     if (rt->realtime) {
         apex__now();
-        if (rt->mode == NORMAL)
+        if (rt->mode == NORMAL) {
+            /* Time moves while processes compute: releases that fell due preempt the
+             * running process at this service call. */
             release_due();
+            apex__preempt_check();
+        }
     }
 }
 

@@ -15,9 +15,10 @@ static void watch(void)
         MESSAGE_SIZE_TYPE len;
         VALIDITY_TYPE v;
         SYSTEM_TIME_TYPE now;
-        READ_SAMPLING_MESSAGE(state_port, (MESSAGE_ADDR_TYPE)&st, &len, &v, &rc);
+        RETURN_CODE_TYPE read_rc;
+        READ_SAMPLING_MESSAGE(state_port, (MESSAGE_ADDR_TYPE)&st, &len, &v, &read_rc);
         GET_TIME(&now, &rc);
-        if (len == (MESSAGE_SIZE_TYPE)sizeof st) {
+        if (read_rc == NO_ERROR && len == (MESSAGE_SIZE_TYPE)sizeof st) {
             reads++;
             invalid += v != VALID;
             if (now - st.t_ns > max_age)

@@ -247,9 +247,9 @@ def _ms(ns: Any) -> str:
 def _state(part: Mapping[str, Any]) -> tuple[str, str]:
     """The state text of a partition row and its style."""
     state = str(part.get("state") or _NONE)
-    status = part.get("exit_status")
+    status = part.get("exit_signal") or part.get("exit_status")
     if status is not None:
-        state = f"{state} ({status})"
+        state = f"{state} ({'SIG' + status if part.get('exit_signal') else status})"
     return state, _STATE_STYLE.get(part.get("state") or "", "")
 
 
@@ -299,6 +299,20 @@ _TIMELINE_STYLES = ("cyan", "magenta", "green", "yellow", "blue", "red", "bright
                     "bright_magenta")
 
 
+def partition_letters(names: list[str]) -> dict[str, str]:
+    """One distinct character per partition: its initial, else its next unused letter, else a digit."""
+    used: set[str] = set()
+    letters: dict[str, str] = {}
+    for name in names:
+        if name in letters:
+            continue
+        candidates = [c.upper() for c in name if c.isalnum()] + list("123456789")
+        letter = next((c for c in candidates if c not in used), "?")
+        used.add(letter)
+        letters[name] = letter
+    return letters
+
+
 def timeline(stats: Mapping[str, Any], width: int = 60) -> list[tuple[str, str]]:
     """The major frame as one row of cells: [(character, partition name or ""), ...].
 
@@ -309,6 +323,8 @@ def timeline(stats: Mapping[str, Any], width: int = 60) -> list[tuple[str, str]]
     windows = stats.get("windows") or []
     if not maf or not windows:
         return []
+    letters = partition_letters([p.get("name") or "?" for p in stats.get("partitions") or []]
+                                + [w["partition"] for w in windows])
     cells = []
     for i in range(width):
         lo, hi = maf * i / width, maf * (i + 1) / width
@@ -318,7 +334,7 @@ def timeline(stats: Mapping[str, Any], width: int = 60) -> list[tuple[str, str]]
             cover = min(hi, end) - max(lo, start)
             if cover > best_cover:
                 best, best_cover = w["partition"], cover
-        cells.append(((best[:1].upper() or "?") if best else "·", best))
+        cells.append((letters.get(best, "?") if best else "·", best))
     return cells
 
 
@@ -336,8 +352,9 @@ def _timeline_text(stats: Mapping[str, Any], width: int = 52):
     maf_ms = stats["major_frame_ns"] / 1e6
     text.append(f"| {maf_ms:g} ms\n")
     text.append("             ")
+    letters = partition_letters([n or "?" for n in names])
     for i, n in enumerate(names):
-        text.append(("  " if i else " ") + f"{(n or '?')[:1].upper()}={n}", style=style.get(n, ""))
+        text.append(("  " if i else " ") + f"{letters[n or '?']}={n}", style=style.get(n, ""))
     return text
 
 

@@ -28,7 +28,14 @@ typedef struct {
     ske_diag_t *diag;
     const ske_load_opts_t *opts;
     bool failed;
+    char *text; /* the module file, to find where start tags begin */
+    size_t text_len;
+    size_t *line_at; /* offset of each line's first character, 1-based */
+    int n_lines;
 } loader_t;
+
+static int tag_line(const loader_t *L, int line, const char *name);
+static int line_of(const loader_t *L, const xmlNode *node);
 
 /* ---- diagnostics ---------------------------------------------------------------------- */
 
@@ -55,6 +62,8 @@ void ske_diag_format(const ske_diag_t *d, char *buf, size_t len)
                  d->message, d->rule);
     else if (d->element[0])
         snprintf(buf, len, "%s:%d: error: %s: %s", d->file, d->line, d->element, d->message);
+    else if (d->rule[0])
+        snprintf(buf, len, "%s:%d: error: %s (rule: %s)", d->file, d->line, d->message, d->rule);
     else
         snprintf(buf, len, "%s:%d: error: %s", d->file, d->line, d->message);
 }
@@ -72,9 +81,89 @@ static void fail(loader_t *L, const xmlNode *node, const char *rule, const char 
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    diag_set(L->diag, L->m->path, node ? (int)xmlGetLineNo(node) : 0,
+    diag_set(L->diag, L->m->path, node ? line_of(L, node) : 0,
              node ? (const char *)node->name : "", rule, "%s", msg);
     L->failed = true;
+}
+
+/* ---- source lines --------------------------------------------------------------------- */
+
+/* libxml2 records the line where an element's start tag ends; a reader wants the line
+ * where it begins, so look back from there for "<Name". */
+static int tag_line(const loader_t *L, int line, const char *name)
+{
+    if (!L->text || line < 1 || line > L->n_lines || !name || !*name)
+        return line;
+    size_t n = strlen(name);
+    for (int l = line; l >= 1 && l > line - 200; l--) {
+        size_t from = L->line_at[l];
+        size_t to = l < L->n_lines ? L->line_at[l + 1] : L->text_len;
+        for (size_t i = from; i + 1 + n <= to; i++) {
+            if (L->text[i] != '<')
+                continue;
+            const char *q = L->text + i + 1;
+            const char *colon = memchr(q, ':', (size_t)(L->text + to - q));
+            const char *local = q;
+            /* accept a prefix: <ima:Linux */
+            if (colon && colon < L->text + to && (size_t)(colon - q) < 32 &&
+                strncmp(colon + 1, name, n) == 0)
+                local = colon + 1;
+            if (strncmp(local, name, n) == 0) {
+                char after = local[n];
+                if (after == ' ' || after == '\t' || after == '\n' || after == '\r' ||
+                    after == '>' || after == '/')
+                    return l;
+            }
+        }
+    }
+    return line;
+}
+
+static int line_of(const loader_t *L, const xmlNode *node)
+{
+    return tag_line(L, (int)xmlGetLineNo(node), (const char *)node->name);
+}
+
+static void index_lines(loader_t *L)
+{
+    FILE *f = fopen(L->m->path, "rb");
+    if (!f)
+        return;
+    size_t cap = 1 << 16, len = 0;
+    char *buf = malloc(cap);
+    size_t r;
+    while (buf && (r = fread(buf + len, 1, cap - len, f)) > 0) {
+        len += r;
+        if (len == cap) {
+            char *nb = realloc(buf, cap * 2);
+            if (!nb) {
+                free(buf);
+                buf = NULL;
+                break;
+            }
+            buf = nb;
+            cap *= 2;
+        }
+    }
+    fclose(f);
+    if (!buf)
+        return;
+    int lines = 1;
+    for (size_t i = 0; i < len; i++)
+        lines += buf[i] == '\n';
+    L->line_at = malloc(((size_t)lines + 2) * sizeof *L->line_at);
+    if (!L->line_at) {
+        free(buf);
+        return;
+    }
+    L->text = buf;
+    L->text_len = len;
+    L->n_lines = lines;
+    L->line_at[1] = 0;
+    int l = 1;
+    for (size_t i = 0; i < len; i++)
+        if (buf[i] == '\n')
+            L->line_at[++l] = i + 1;
 }
 
 /* ---- numbers -------------------------------------------------------------------------- */
@@ -113,8 +202,8 @@ bool ske_parse_seconds(const char *s, int64_t *ns)
 
 bool ske_parse_u64(const char *s, uint64_t *v)
 {
-    if (!s || !*s || *s == '-' || *s == '+' || *s == ' ')
-        return false;
+    if (!s || *s < '0' || *s > '9')
+        return false; /* no blank, no sign: strtoull would accept both */
     int base = (s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) ? 16 : 10;
     if (base == 16 && !s[2])
         return false;
@@ -260,14 +349,28 @@ static void schema_error(void *ctx, xmlErrorPtr err)
         msg[--n] = '\0';
     const char *elem = "";
     const xmlNode *node = err->node;
+    char attr_buf[64] = "";
     const char *attr_name_s = NULL;
     if (node && node->type == XML_ATTRIBUTE_NODE && node->parent) {
         attr_name_s = (const char *)node->name;
         node = node->parent;
+    } else {
+        /* libxml2 reports attribute errors on the element and names the attribute in the
+         * message: "Element 'X', attribute 'Y': ..." */
+        const char *a = strstr(msg, "attribute '");
+        if (a) {
+            a += strlen("attribute '");
+            const char *e = strchr(a, '\'');
+            if (e && (size_t)(e - a) < sizeof attr_buf) {
+                memcpy(attr_buf, a, (size_t)(e - a));
+                attr_buf[e - a] = '\0';
+                attr_name_s = attr_buf;
+            }
+        }
     }
     if (node && node->type == XML_ELEMENT_NODE)
         elem = (const char *)node->name;
-    int line = err->line ? err->line : (node ? (int)xmlGetLineNo(node) : 0);
+    int line = node && node->type == XML_ELEMENT_NODE ? line_of(L, node) : err->line;
     /* Say what a malformed number means rather than quoting the schema's regular expression. */
     char value[128] = "";
     if (attr_name_s && node)
@@ -278,9 +381,11 @@ static void schema_error(void *ctx, xmlErrorPtr err)
                  "%s='%s' is not a valid duration: expected decimal seconds such as 0.010, "
                  "at most 9 decimals", attr_name_s, value);
     } else if (attr_name_s && (strstr(attr_name_s, "Identifier") || strstr(attr_name_s, "Size") ||
-                               strstr(attr_name_s, "Nb"))) {
+                               strstr(attr_name_s, "Nb") || strstr(attr_name_s, "Address"))) {
         diag_set(L->diag, L->m->path, line, elem, "numbers are positive integers",
-                 "%s='%s' is not a valid number", attr_name_s, value);
+                 "%s='%s' is not a valid number: expected a positive integer%s", attr_name_s,
+                 value, strstr(attr_name_s, "Bytes") || strstr(attr_name_s, "Address") ||
+                            strstr(attr_name_s, "StackSize") ? " (decimal or 0x-hexadecimal)" : "");
     } else {
         diag_set(L->diag, L->m->path, line, elem, "schema " SCHEMA_FILE, "%s", msg);
     }
@@ -366,7 +471,7 @@ static void load_port(loader_t *L, const xmlNode *n, ske_partition_cfg_t *p, ske
     memset(port, 0, sizeof *port);
     port->kind = kind;
     port->channel = -1;
-    port->line = (int)xmlGetLineNo(n);
+    port->line = line_of(L, n);
     if (!attr_name(L, n, "Name", port->name))
         return;
     if (ske_config_port_by_name(p, port->name) >= 0) {
@@ -390,6 +495,10 @@ static void load_port(loader_t *L, const xmlNode *n, ske_partition_cfg_t *p, ske
         if (v == 0)
             fail(L, n, "MaxNbMessages is positive", "MaxNbMessages must be at least 1");
         port->max_nb = (uint32_t)v;
+        if ((uint64_t)port->max_nb * port->max_size > SKE_PORT_BYTES_MAX)
+            fail(L, n, "a queuing port holds at most 64 MiB",
+                 "MaxNbMessages=%u of %u bytes needs %llu MiB", port->max_nb, port->max_size,
+                 (unsigned long long)((uint64_t)port->max_nb * port->max_size >> 20));
     }
     p->n_ports++;
 }
@@ -403,7 +512,7 @@ static void load_partition(loader_t *L, const xmlNode *n)
     }
     ske_partition_cfg_t *p = &m->partitions[m->n_partitions];
     memset(p, 0, sizeof *p);
-    p->line = (int)xmlGetLineNo(n);
+    p->line = line_of(L, n);
     uint64_t id;
     if (!attr_u64(L, n, "PartitionIdentifier", &id, INT32_MAX, true) ||
         !attr_name(L, n, "PartitionName", p->name))
@@ -431,13 +540,18 @@ static void load_partition(loader_t *L, const xmlNode *n)
         else if (is_elem(c, "Process", false)) {
             if (p->n_processes < SKE_MAX_PORTS) {
                 ske_process_cfg_t *pr = &p->processes[p->n_processes++];
-                pr->line = (int)xmlGetLineNo(c);
+                pr->line = line_of(L, c);
                 attr_name(L, c, "Name", pr->name);
                 uint64_t ss = 0;
                 if (attr_u64(L, c, "StackSize", &ss, UINT32_MAX, false))
                     pr->stack_size = (uint32_t)ss;
             }
         } else if (is_elem(c, "Linux", true)) {
+            if (have_linux) {
+                fail(L, c, "each Partition has one ima:Linux element",
+                     "partition '%s' names its program twice", p->name);
+                continue;
+            }
             have_linux = true;
             attr(c, "Executable", p->exe_name, sizeof p->exe_name);
             char args[2048];
@@ -511,7 +625,7 @@ static void load_schedule(loader_t *L, const xmlNode *n)
             }
             ske_window_cfg_t *win = &m->windows[m->n_windows];
             memset(win, 0, sizeof *win);
-            win->line = (int)xmlGetLineNo(w);
+            win->line = line_of(L, w);
             win->partition = pi;
             uint64_t wid;
             if (!attr_u64(L, w, "WindowIdentifier", &wid, INT32_MAX, true) ||
@@ -531,11 +645,14 @@ static void load_schedule(loader_t *L, const xmlNode *n)
                      "greater than 0");
                 return;
             }
-            if (win->offset_ns + win->duration_ns > m->major_frame_ns) {
+            if (win->offset_ns >= m->major_frame_ns ||
+                win->duration_ns > m->major_frame_ns - win->offset_ns) {
                 fail(L, w, "windows end within the major frame",
                      "window %d of partition '%s' runs from %lld ns to %lld ns, past the major "
                      "frame of %lld ns", win->id, p->name, (long long)win->offset_ns,
-                     (long long)(win->offset_ns + win->duration_ns), (long long)m->major_frame_ns);
+                     (long long)(win->offset_ns > INT64_MAX - win->duration_ns
+                                     ? INT64_MAX : win->offset_ns + win->duration_ns),
+                     (long long)m->major_frame_ns);
                 return;
             }
             win->period_start = attr_bool(w, "PartitionPeriodStart", false);
@@ -653,7 +770,7 @@ static void load_channel(loader_t *L, const xmlNode *n)
     }
     ske_channel_cfg_t *ch = &m->channels[m->n_channels];
     memset(ch, 0, sizeof *ch);
-    ch->line = (int)xmlGetLineNo(n);
+    ch->line = line_of(L, n);
     uint64_t id;
     if (!attr_u64(L, n, "ChannelIdentifier", &id, INT32_MAX, true) ||
         !attr_name(L, n, "ChannelName", ch->name))
@@ -666,6 +783,7 @@ static void load_channel(loader_t *L, const xmlNode *n)
             return;
         }
     const xmlNode *src_node = NULL;
+    const xmlNode *dst_node[SKE_MAX_DESTINATIONS] = {NULL};
     for (const xmlNode *c = n->children; c && !L->failed; c = c->next) {
         if (is_elem(c, "Source", false)) {
             src_node = c;
@@ -678,7 +796,7 @@ static void load_channel(loader_t *L, const xmlNode *n)
             }
             if (!load_endpoint(L, c, &ch->dst[ch->n_dst]))
                 return;
-            ch->n_dst++;
+            dst_node[ch->n_dst++] = c;
         }
     }
     if (!src_node || ch->n_dst == 0) {
@@ -710,26 +828,26 @@ static void load_channel(loader_t *L, const xmlNode *n)
         ske_port_cfg_t *dp = port_of(m, ch->dst[d]);
         const char *pname = m->partitions[ch->dst[d].partition].name;
         if (dp->kind != ch->kind) {
-            fail(L, n, "a channel connects ports of one kind",
+            fail(L, dst_node[d], "a channel connects ports of one kind",
                  "channel '%s' connects %s port '%s' to %s port '%s' of partition '%s'",
                  ch->name, kind_name(sp->kind), sp->name, kind_name(dp->kind), dp->name, pname);
             return;
         }
         if (dp->dir != SKE_DIR_DESTINATION) {
-            fail(L, n, "a channel's Destination is a DESTINATION port",
+            fail(L, dst_node[d], "a channel's Destination is a DESTINATION port",
                  "port '%s' of partition '%s' is a SOURCE port, it cannot be a destination of "
                  "channel '%s'", dp->name, pname, ch->name);
             return;
         }
         if (dp->max_size != sp->max_size) {
-            fail(L, n, "the ports of a channel have the same MaxMessageSize",
+            fail(L, dst_node[d], "the ports of a channel have the same MaxMessageSize",
                  "channel '%s': source port '%s' has MaxMessageSize=%u but destination port "
                  "'%s' of partition '%s' has %u", ch->name, sp->name, sp->max_size, dp->name,
                  pname, dp->max_size);
             return;
         }
         if (dp->channel >= 0) {
-            fail(L, n, "a port belongs to one channel",
+            fail(L, dst_node[d], "a port belongs to one channel",
                  "port '%s' of partition '%s' is already a destination of channel '%s'",
                  dp->name, pname, m->channels[dp->channel].name);
             return;
@@ -826,9 +944,12 @@ int ske_config_load(const char *path, const ske_load_opts_t *opts, ske_module_cf
         return SKE_E_NOMEM;
     snprintf(m->path, sizeof m->path, "%s", path);
     loader_t L = {.m = m, .diag = diag, .opts = opts};
+    index_lines(&L);
 
     if (access(path, R_OK) != 0) {
         diag_set(diag, path, 0, "", "", "cannot read the module: %s", strerror(errno));
+        free(L.text);
+        free(L.line_at);
         free(m);
         return SKE_E_IO;
     }
@@ -852,6 +973,8 @@ int ske_config_load(const char *path, const ske_load_opts_t *opts, ske_module_cf
 out:
     if (doc)
         xmlFreeDoc(doc);
+    free(L.text);
+    free(L.line_at);
     if (rc != SKE_OK) {
         ske_config_free(m);
         return rc;

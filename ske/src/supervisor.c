@@ -212,6 +212,7 @@ static void fill_ctl(ske_t *s, part_t *p)
     memset(c, 0, sizeof *c);
     c->magic = SKE_ABI_MAGIC;
     c->version = SKE_ABI_VERSION;
+    c->ctl_size = (uint32_t)sizeof *c;
     c->partition_id = p->cfg->id;
     snprintf(c->partition_name, sizeof c->partition_name, "%s", p->cfg->name);
     snprintf(c->node, sizeof c->node, "%s", s->node);
@@ -912,6 +913,12 @@ static void write_stats(ske_t *s, double wall_s)
                 state_name(p->state));
         if (p->state == PS_EXITED || p->state == PS_CRASHED)
             fprintf(f, "%d", p->exit_code);
+        else
+            fputs("null", f);
+        const char *sig = p->state == PS_CRASHED ? sigabbrev_np(p->exit_code) : NULL;
+        fputs(",\"exit_signal\":", f);
+        if (sig)
+            fprintf(f, "\"%s\"", sig);
         else
             fputs("null", f);
         fprintf(f, ",\"cpu_outside_windows_ns_max\":%" PRId64 "}", p->cpu_outside_max_ns);

@@ -26,3 +26,16 @@ def test_a_cell_goes_to_the_window_covering_most_of_it():
 def test_no_windows_no_timeline():
     assert timeline({"major_frame_ns": 50_000_000}) == []
     assert timeline({}) == []
+
+
+def test_partitions_sharing_an_initial_get_distinct_letters():
+    stats = {
+        "major_frame_ns": 30,
+        "partitions": [{"name": "spin"}, {"name": "sink"}, {"name": "stopper"}],
+        "windows": [
+            {"window": 1, "partition": "spin", "offset_ns": 0, "duration_ns": 10},
+            {"window": 2, "partition": "sink", "offset_ns": 10, "duration_ns": 10},
+            {"window": 3, "partition": "stopper", "offset_ns": 20, "duration_ns": 10},
+        ],
+    }
+    assert "".join(ch for ch, _ in timeline(stats, width=3)) == "SIT"

@@ -88,6 +88,7 @@ typedef struct {
 typedef struct {
     uint32_t magic;
     uint32_t version;
+    uint32_t ctl_size; /* sizeof(ske_ctl_t) as the SKE was built: catches a stale partition */
     int32_t partition_id;
     char partition_name[SKE_NAME_MAX];
     char node[SKE_NAME_MAX];

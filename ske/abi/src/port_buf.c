@@ -25,9 +25,19 @@ size_t ske_sampling_map_size(uint32_t max_size)
     return round_page(sizeof(ske_sampling_hdr_t) + 2u * ske_slot_stride(max_size));
 }
 
+/* Queue slots: a power of two at least the capacity, so that the 32-bit message counters
+ * map to the same slot on both sides of their wrap-around. */
+static uint32_t queue_slots(uint32_t capacity)
+{
+    uint32_t n = 1;
+    while (n < capacity && n < (1u << 31))
+        n <<= 1;
+    return n;
+}
+
 size_t ske_queue_map_size(uint32_t max_size, uint32_t capacity)
 {
-    return round_page(sizeof(ske_queue_hdr_t) + (size_t)capacity * ske_slot_stride(max_size));
+    return round_page(sizeof(ske_queue_hdr_t) + (size_t)queue_slots(capacity) * ske_slot_stride(max_size));
 }
 
 static ske_slot_hdr_t *slot_at(void *base, size_t hdr, uint32_t max_size, uint32_t i)
@@ -97,7 +107,7 @@ bool ske_queue_push(void *mem, uint32_t max_size, uint32_t capacity, uint32_t ta
     uint32_t head = atomic_load_explicit(&q->head, memory_order_relaxed);
     if (head - tail >= capacity)
         return false;
-    ske_slot_hdr_t *s = slot_at(mem, sizeof(*q), max_size, head % capacity);
+    ske_slot_hdr_t *s = slot_at(mem, sizeof(*q), max_size, head & (queue_slots(capacity) - 1u));
     if (len > max_size)
         len = max_size;
     s->t_ns = t_ns;
@@ -111,7 +121,8 @@ bool ske_queue_push(void *mem, uint32_t max_size, uint32_t capacity, uint32_t ta
 void ske_queue_peek(const void *mem, uint32_t max_size, uint32_t capacity, uint32_t tail,
                     void *msg, uint32_t *len, int64_t *t_ns)
 {
-    const ske_slot_hdr_t *s = slot_at((void *)mem, sizeof(ske_queue_hdr_t), max_size, tail % capacity);
+    const ske_slot_hdr_t *s = slot_at((void *)mem, sizeof(ske_queue_hdr_t), max_size,
+                                      tail & (queue_slots(capacity) - 1u));
     uint32_t n = s->len <= max_size ? s->len : max_size;
     memcpy(msg, s + 1, n);
     *len = n;

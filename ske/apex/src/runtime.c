@@ -80,8 +80,10 @@ __attribute__((constructor)) static void apex_attach(void)
     unsetenv(SKE_ENV_CTL_FD);
     apex_rt_t *rt = &apex__rt;
     rt->ctl = m;
-    if (rt->ctl->magic != SKE_ABI_MAGIC || rt->ctl->version != SKE_ABI_VERSION)
-        fatal("apex: the SKE speaks another version of the partition interface");
+    if (rt->ctl->magic != SKE_ABI_MAGIC || rt->ctl->version != SKE_ABI_VERSION ||
+        rt->ctl->ctl_size != sizeof(ske_ctl_t))
+        fatal("apex: this partition was built against another version of the SKE's partition "
+              "interface: rebuild it");
     rt->realtime = rt->ctl->time_mode == SKE_TIME_REALTIME;
     if (rt->realtime)
         prctl(PR_SET_TIMERSLACK, 1UL); /* time-outs inside a window wake on time */

@@ -15,6 +15,7 @@
 #define SKE_MAX_DESTINATIONS 16
 #define SKE_MAX_ARGS 32
 #define SKE_PATH_MAX 4096
+#define SKE_PORT_BYTES_MAX (64u << 20) /* messages a queuing port may hold, in bytes */
 
 /* Status codes of the SKE library (0 = ok). */
 enum {

@@ -116,7 +116,17 @@ void ske_request_stop(ske_t *ske, int signo) { ske->stop_signal = signo; }
 void ske_notify_child(ske_t *ske) { ske->child_event = 1; }
 int ske_stop_signal(const ske_t *ske) { return ske->stop_signal; }
 
-static void cpu_relax(void) { __asm__ __volatile__("pause" ::: "memory"); }
+/* A spin-wait hint to the CPU (a sibling hyper-thread gets the pipeline meanwhile). */
+static void cpu_relax(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    __asm__ __volatile__("pause" ::: "memory");
+#elif defined(__aarch64__)
+    __asm__ __volatile__("yield" ::: "memory");
+#else
+    atomic_signal_fence(memory_order_seq_cst);
+#endif
+}
 
 /* ---- memory objects ------------------------------------------------------------------- */
 

@@ -84,6 +84,8 @@ struct ske {
     int64_t start_mono_ns;
     int64_t frames_done;
     int64_t now_ns; /* module time of the current window start */
+    int64_t win_end_ns; /* and its end */
+    int cur_partition; /* partition holding the current window, -1 between windows */
     int64_t prev_yield_mono_ns; /* the previous window's yield, for the switch figure */
     uint8_t *xfer; /* one message, for queue transfers */
     volatile sig_atomic_t stop_signal;
@@ -424,8 +426,13 @@ static int64_t cpu_now(const part_t *p)
     return (int64_t)ts.tv_sec * 1000000000LL + ts.tv_nsec;
 }
 
+static void drain_events(ske_t *s, part_t *p, int64_t win_start, int64_t win_end);
+
 static void record_exit(ske_t *s, part_t *p, int status)
 {
+    /* What the partition reported before it ended comes first in the trace. */
+    if (p->ctl && p->index == s->cur_partition)
+        drain_events(s, p, s->now_ns, s->win_end_ns);
     p->state = WIFSIGNALED(status) ? PS_CRASHED : PS_EXITED;
     p->exit_code = WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status);
     p->pid = 0;
@@ -683,6 +690,8 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
     int64_t start = slot->start_ns;
     int64_t end = slot->end_ns;
     s->now_ns = start;
+    s->win_end_ns = end;
+    s->cur_partition = -1;
     bool rt = s->time_mode == SKE_TIME_REALTIME;
     int64_t start_mono = s->epoch_mono_ns + start;
     int64_t late = 0;
@@ -719,6 +728,7 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
     bool granted = false;
     if (alive(p)) {
         granted = true;
+        s->cur_partition = w->partition;
         int64_t cpu0 = cpu_now(p);
         if (p->cpu_at_yield_ns >= 0 && cpu0 >= 0 && cpu0 - p->cpu_at_yield_ns > p->cpu_outside_max_ns)
             p->cpu_outside_max_ns = cpu0 - p->cpu_at_yield_ns;
@@ -788,6 +798,7 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
         drain_events(s, p, start, end);
         transfer_queues(s, p, end);
     }
+    s->cur_partition = -1;
     ske_trace_begin(&s->trace, end, "ske", "window_end");
     ske_trace_str(&s->trace, "partition", p->cfg->name);
     ske_trace_int(&s->trace, "window", w->id);
@@ -819,6 +830,7 @@ int ske_create(const ske_module_cfg_t *cfg, const ske_run_opts_t *opts, ske_t **
     }
     s->cfg = cfg;
     s->opts = *opts;
+    s->cur_partition = -1;
     s->time_mode = opts->time_mode >= 0 ? (ske_time_mode_t)opts->time_mode : cfg->time_mode;
     snprintf(s->node, sizeof s->node, "%s", opts->node ? opts->node : cfg->node);
     s->xfer = malloc(SYSTEM_MESSAGE_MAX);

@@ -67,6 +67,16 @@ typedef struct {
     apex_port_t ports[SKE_MAX_PORTS];
 } apex_rt_t;
 
+/* t + d for d ≥ 0, or false when the sum passes the end of the 64-bit clock (the standard's
+ * "out of range ... e.g. calculation causes overflow of underlying clock"). */
+static inline bool apex__time_add(int64_t t, int64_t d, int64_t *out)
+{
+    if (d > 0 && t > INT64_MAX - d)
+        return false;
+    *out = t + d;
+    return true;
+}
+
 /* The partition's one run-time: the APEX interface has no context argument. */
 extern apex_rt_t apex__rt;
 

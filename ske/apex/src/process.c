@@ -133,6 +133,14 @@ void START(
         *RETURN_CODE = NO_ACTION;
         return;
     }
+    int64_t now = apex__now();
+    int64_t deadline = INFINITE_TIME_VALUE;
+    if (rt->mode == NORMAL && p->attr.PERIOD == INFINITE_TIME_VALUE &&
+        p->attr.TIME_CAPACITY != INFINITE_TIME_VALUE &&
+        !apex__time_add(now, p->attr.TIME_CAPACITY, &deadline)) {
+        *RETURN_CODE = INVALID_CONFIG; /* the deadline time is out of range */
+        return;
+    }
     getcontext(&p->ctx);
     p->ctx.uc_stack.ss_sp = (char *)p->stack_map + GUARD_SIZE;
     p->ctx.uc_stack.ss_size = p->stack_map_size - GUARD_SIZE;
@@ -147,10 +155,8 @@ void START(
         *RETURN_CODE = NO_ERROR;
         return;
     }
-    int64_t now = apex__now();
     if (p->attr.PERIOD == INFINITE_TIME_VALUE) {
-        p->deadline_time = p->attr.TIME_CAPACITY == INFINITE_TIME_VALUE ? INFINITE_TIME_VALUE
-                                                                         : now + p->attr.TIME_CAPACITY;
+        p->deadline_time = deadline;
         apex__make_ready(p);
     } else {
         p->state = WAITING;

@@ -163,7 +163,9 @@ void SEND_QUEUING_MESSAGE(
         *RETURN_CODE = INVALID_CONFIG;
         return;
     }
-    if (LENGTH <= 0 || !MESSAGE_ADDR || TIME_OUT < INFINITE_TIME_VALUE) {
+    int64_t until = INT64_MAX;
+    if (LENGTH <= 0 || !MESSAGE_ADDR || TIME_OUT < INFINITE_TIME_VALUE ||
+        (TIME_OUT > 0 && !apex__time_add(apex__now(), TIME_OUT, &until))) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -190,7 +192,7 @@ void SEND_QUEUING_MESSAGE(
     p->wait_order = ++apex__rt.order;
     p->q_msg = MESSAGE_ADDR;
     p->q_len = LENGTH;
-    p->wake_at = TIME_OUT == INFINITE_TIME_VALUE ? INT64_MAX : apex__now() + TIME_OUT;
+    p->wake_at = until;
     *RETURN_CODE = apex__block(p);
 }
 
@@ -203,7 +205,9 @@ void RECEIVE_QUEUING_MESSAGE(
 {
     apex__sync();
     int k = apex__port_index(QUEUING_PORT_ID, SKE_PORT_QUEUING);
-    if (k < 0 || TIME_OUT < INFINITE_TIME_VALUE || !MESSAGE_ADDR || !LENGTH) {
+    int64_t until = INT64_MAX;
+    if (k < 0 || TIME_OUT < INFINITE_TIME_VALUE || !MESSAGE_ADDR || !LENGTH ||
+        (TIME_OUT > 0 && !apex__time_add(apex__now(), TIME_OUT, &until))) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -234,7 +238,7 @@ void RECEIVE_QUEUING_MESSAGE(
     p->wait_order = ++apex__rt.order;
     p->q_buf = MESSAGE_ADDR;
     p->q_len_out = &len;
-    p->wake_at = TIME_OUT == INFINITE_TIME_VALUE ? INT64_MAX : apex__now() + TIME_OUT;
+    p->wake_at = until;
     RETURN_CODE_TYPE rc = apex__block(p);
     if (rc == NO_ERROR || rc == INVALID_CONFIG)
         *LENGTH = len;

@@ -188,10 +188,12 @@ static void release(apex_proc_t *p)
 {
     if (p->wait == WAIT_PERIOD) {
         int64_t r = p->wake_at;
-        p->deadline_time = p->attr.TIME_CAPACITY == INFINITE_TIME_VALUE
-                               ? INFINITE_TIME_VALUE
-                               : r + p->attr.TIME_CAPACITY;
-        p->next_release = r + p->attr.PERIOD;
+        p->deadline_time = INFINITE_TIME_VALUE;
+        if (p->attr.TIME_CAPACITY != INFINITE_TIME_VALUE &&
+            !apex__time_add(r, p->attr.TIME_CAPACITY, &p->deadline_time))
+            p->deadline_time = INFINITE_TIME_VALUE;
+        if (!apex__time_add(r, p->attr.PERIOD, &p->next_release))
+            p->next_release = INT64_MAX; /* the end of the clock: no further release */
         p->wait_rc = NO_ERROR;
     } else if (p->wait == WAIT_DELAY) {
         p->wait_rc = NO_ERROR;
@@ -310,9 +312,12 @@ void apex__enter_normal(void)
             continue;
         p->start_pending = false;
         if (p->attr.PERIOD == INFINITE_TIME_VALUE) {
-            p->deadline_time = p->attr.TIME_CAPACITY == INFINITE_TIME_VALUE
-                                   ? INFINITE_TIME_VALUE
-                                   : now + p->attr.TIME_CAPACITY;
+            /* A deadline past the end of the clock is no deadline (the health monitor's
+             * illegal-request report for it comes with the HM tables). */
+            p->deadline_time = INFINITE_TIME_VALUE;
+            if (p->attr.TIME_CAPACITY != INFINITE_TIME_VALUE &&
+                !apex__time_add(now, p->attr.TIME_CAPACITY, &p->deadline_time))
+                p->deadline_time = INFINITE_TIME_VALUE;
             apex__make_ready(p);
         } else {
             p->state = WAITING;

@@ -13,7 +13,8 @@ void TIMED_WAIT(
         *RETURN_CODE = INVALID_MODE; /* the initialisation process cannot wait */
         return;
     }
-    if (DELAY_TIME < 0) {
+    int64_t wake;
+    if (DELAY_TIME < 0 || !apex__time_add(apex__now(), DELAY_TIME, &wake)) {
         *RETURN_CODE = INVALID_PARAM; /* includes INFINITE_TIME_VALUE */
         return;
     }
@@ -25,7 +26,7 @@ void TIMED_WAIT(
         return;
     }
     p->wait = WAIT_DELAY;
-    p->wake_at = apex__now() + DELAY_TIME;
+    p->wake_at = wake;
     apex__block(p);
 }
 

@@ -270,7 +270,8 @@ static void fill_ctl(ske_t *s, part_t *p)
 
 static void trace_mode(ske_t *s, part_t *p, int64_t t, uint32_t mode, uint32_t from, const char *why)
 {
-    ske_trace_begin(&s->trace, t, p->cfg->name, "mode");
+    /* The SKE's own record of a mode change it made (power-on, IDLE, restart). */
+    ske_trace_begin(&s->trace, t, "ske", "mode");
     ske_trace_str(&s->trace, "partition", p->cfg->name);
     ske_trace_str(&s->trace, "mode", mode_name(mode));
     ske_trace_str(&s->trace, "from", mode_name(from));
@@ -745,21 +746,18 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
         r = wait_yield(s, p, w->duration_ns, s->epoch_mono_ns + end, cpu0);
         int64_t cpu1 = cpu_now(p);
         if (r == W_OVERRUN) {
+            /* No waiting for the stop to take effect: a process with SIGSTOP pending cannot
+             * return to user space, so it computes nothing more whether it is on a CPU now or
+             * waiting for one; waiting for it could only delay the next window. A stop that
+             * has not landed yet when the partition's next window comes is discarded by
+             * that window's SIGCONT. */
             kill(p->pid, SIGSTOP);
-            int st;
-            pid_t wp = waitpid(p->pid, &st, WUNTRACED);
-            if (wp == p->pid && !WIFSTOPPED(st)) {
-                record_exit(s, p, st);
-                r = W_EXIT;
+            if (yielded(p)) {
+                kill(p->pid, SIGCONT); /* it handed the CPU back in the instant before */
+                r = W_YIELD;
             } else {
-                /* It may have yielded in the instant before the stop took effect. */
-                if (yielded(p)) {
-                    kill(p->pid, SIGCONT);
-                    r = W_YIELD;
-                } else {
-                    p->state = PS_STOPPED;
-                    p->overruns++;
-                }
+                p->state = PS_STOPPED;
+                p->overruns++;
             }
         }
         if (cpu0 >= 0 && cpu1 >= 0)
@@ -785,6 +783,10 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
         s->prev_yield_mono_ns = 0;
     }
 
+    /* In time order: what the partition reported inside its window, then what happened at
+     * the window's end. */
+    if (granted && p->ctl)
+        drain_events(s, p, start, end);
     if (r == W_OVERRUN) {
         ske_trace_begin(&s->trace, end, "ske", "overrun");
         ske_trace_str(&s->trace, "partition", p->cfg->name);
@@ -794,10 +796,8 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
         ske_trace_str(&s->trace, "action", "stopped");
         ske_trace_end(&s->trace);
     }
-    if (granted && p->ctl) {
-        drain_events(s, p, start, end);
+    if (granted && p->ctl)
         transfer_queues(s, p, end);
-    }
     s->cur_partition = -1;
     ske_trace_begin(&s->trace, end, "ske", "window_end");
     ske_trace_str(&s->trace, "partition", p->cfg->name);

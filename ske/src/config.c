@@ -291,7 +291,7 @@ static bool attr_name(loader_t *L, const xmlNode *n, const char *name, char *out
         fail(L, n, "names have at most 30 characters", "%s='%s' is too long", name, buf);
         return false;
     }
-    snprintf(out, SKE_NAME_MAX, "%s", buf);
+    memcpy(out, buf, strlen(buf) + 1); /* fits: checked above */
     return true;
 }
 

@@ -526,11 +526,13 @@ static wres_t wait_yield(ske_t *s, part_t *p, int64_t budget_ns, int64_t end_mon
             if (wait_ns < 50000)
                 wait_ns = 50000;
         }
+        atomic_store(&p->ctl->ske_sleeping, 1);
         uint32_t v = atomic_load(&p->ctl->yield_seq);
-        if (v == p->grant_seq)
-            return W_YIELD;
-        struct timespec ts = {wait_ns / 1000000000LL, wait_ns % 1000000000LL};
-        ske_futex_wait(&p->ctl->yield_seq, v, &ts);
+        if (v != p->grant_seq) {
+            struct timespec ts = {wait_ns / 1000000000LL, wait_ns % 1000000000LL};
+            ske_futex_wait(&p->ctl->yield_seq, v, &ts);
+        }
+        atomic_store(&p->ctl->ske_sleeping, 0);
     }
 }
 

@@ -110,6 +110,8 @@ typedef struct {
     _Atomic uint32_t yield_seq;
     _Atomic uint32_t ready; /* partition set it once attached and waiting for its first grant */
     _Atomic uint32_t stop_request; /* SKE asks the partition to exit at its next grant */
+    _Atomic uint32_t ske_sleeping; /* the SKE sleeps on yield_seq: a yield must wake it */
+    uint32_t pad_sleeping;
     _Atomic int64_t win_start_ns; /* current window, partition time */
     _Atomic int64_t win_end_ns;
 

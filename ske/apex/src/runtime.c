@@ -56,8 +56,12 @@ void apex__yield_cpu(void)
         take_grant();
     atomic_store(&c->yield_t_ns, apex__now());
     atomic_store(&c->yield_mono_ns, ske_mono_ns());
-    atomic_store_explicit(&c->yield_seq, rt->seen_grant, memory_order_release);
-    ske_futex_wake(&c->yield_seq);
+    /* Sequentially consistent store then load, against the SKE's store of ske_sleeping then
+     * load of yield_seq: one of the two always sees the other, so no wake-up is lost, and
+     * the system call is saved while the SKE spins (the usual case). */
+    atomic_store(&c->yield_seq, rt->seen_grant);
+    if (atomic_load(&c->ske_sleeping))
+        ske_futex_wake(&c->yield_seq);
     wait_grant();
 }
 

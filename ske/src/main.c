@@ -39,7 +39,8 @@ static void usage(FILE *f)
           "                        (default: $IMA_PARTITION_PATH)\n"
           "  --check               validate the module and exit\n"
           "  -q, --quiet           print nothing but errors\n"
-          "exit status: 0 done, 1 run-time failure, 2 usage or invalid module, 128+N stopped by signal N\n",
+          "exit status: 0 done, 1 run-time failure, 2 usage or invalid module,\n"
+          "             3 shut down by the health monitor (module-level SHUTDOWN), 128+N stopped by signal N\n",
           f);
 }
 
@@ -140,6 +141,7 @@ int main(int argc, char **argv)
 
     rc = ske_run(ske, err, sizeof err);
     int sig = ske_stop_signal(ske);
+    bool shutdown = ske_shut_down_by_hm(ske);
     g_ske = NULL;
     ske_destroy(ske);
     ske_config_free(cfg);
@@ -147,5 +149,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "ima-ske: error: %s\n", err);
         return 1;
     }
-    return sig ? 128 + sig : 0;
+    if (sig)
+        return 128 + sig;
+    return shutdown ? 3 : 0;
 }

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <sys/personality.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -67,6 +68,7 @@ typedef struct {
     uint64_t windows;
     uint64_t overruns;
     uint64_t restarts;
+    bool exit_to_judge; /* ended on its own: the health monitor has yet to decide */
 } part_t;
 
 struct ske {
@@ -88,6 +90,9 @@ struct ske {
     int cur_partition; /* partition holding the current window, -1 between windows */
     int64_t prev_yield_mono_ns; /* the previous window's yield, for the switch figure */
     uint8_t *xfer; /* one message, for queue transfers */
+    bool hm_shutdown; /* a module-level SHUTDOWN: the run ends */
+    bool hm_reset; /* a module-level RESET: every partition restarts at the next frame */
+    uint64_t hm_events;
     volatile sig_atomic_t stop_signal;
     volatile sig_atomic_t child_event;
     char exit_reason[16];
@@ -117,6 +122,7 @@ static bool alive(const part_t *p) { return p->state == PS_RUNNING || p->state =
 void ske_request_stop(ske_t *ske, int signo) { ske->stop_signal = signo; }
 void ske_notify_child(ske_t *ske) { ske->child_event = 1; }
 int ske_stop_signal(const ske_t *ske) { return ske->stop_signal; }
+bool ske_shut_down_by_hm(const ske_t *ske) { return ske->hm_shutdown; }
 
 /* A spin-wait hint to the CPU (a sibling hyper-thread gets the pipeline meanwhile). */
 static void cpu_relax(void)
@@ -262,6 +268,9 @@ static void fill_ctl(ske_t *s, part_t *p)
         atomic_store(&d->overflow_ack, overflows);
     }
     atomic_store(&c->mode, p->initial_mode);
+    _Static_assert(SKE_HM_STATES == HM_STATE_COUNT && SKE_HM_ERRORS == HM_ERR_COUNT,
+                   "the control block's HM table has the health monitor's shape");
+    memcpy(c->hm_level, s->cfg->hm.level, sizeof c->hm_level);
     p->grant_seq = 0;
     p->mode_request_seq = 0;
 }
@@ -291,6 +300,9 @@ static void child_exec(ske_t *s, part_t *p, int errpipe, char **envp)
      * only, which then stops them. They die with the SKE. */
     setpgid(0, 0);
     prctl(PR_SET_PDEATHSIG, SIGKILL);
+    /* Same addresses on every run: fault addresses in the trace (and anything a partition
+     * derives from its own addresses) repeat, so emulated runs stay byte-identical. */
+    personality(ADDR_NO_RANDOMIZE);
     struct sigaction dfl = {.sa_handler = SIG_DFL};
     sigaction(SIGINT, &dfl, NULL);
     sigaction(SIGTERM, &dfl, NULL);
@@ -437,6 +449,7 @@ static void record_exit(ske_t *s, part_t *p, int status)
     p->state = WIFSIGNALED(status) ? PS_CRASHED : PS_EXITED;
     p->exit_code = WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status);
     p->pid = 0;
+    p->exit_to_judge = true;
     ske_trace_begin(&s->trace, s->now_ns, "ske", "partition_exit");
     ske_trace_str(&s->trace, "partition", p->cfg->name);
     if (WIFSIGNALED(status)) {
@@ -471,6 +484,151 @@ static void kill_partition(part_t *p)
         waitpid(p->pid, NULL, 0);
         p->pid = 0;
     }
+}
+
+/* ---- health monitoring ------------------------------------------------------------------ */
+
+/* The system state a partition is in, as far as the SKE can tell. */
+static hm_state_t partition_state(const part_t *p)
+{
+    uint32_t mode = p->ctl ? atomic_load(&p->ctl->mode) : SKE_MODE_COLD_START;
+    return mode == SKE_MODE_NORMAL ? HM_STATE_PROCESS : HM_STATE_PARTITION_INIT;
+}
+
+/* Writes an hm event's fields; the caller ends it (ske_trace_end). */
+static void trace_hm_fields(ske_t *s, int64_t t, const part_t *p, hm_error_t err, hm_level_t level,
+                            hm_action_t action, hm_state_t state, int32_t process,
+                            const char *pname, const char *message, size_t mlen, const char *note)
+{
+    s->hm_events++;
+    ske_trace_begin(&s->trace, t, level == HM_LEVEL_PROCESS ? p->cfg->name : "ske", "hm");
+    ske_trace_str(&s->trace, "error", hm_error_name(err));
+    ske_trace_str(&s->trace, "level", hm_level_name(level));
+    ske_trace_str(&s->trace, "action", hm_action_name(action));
+    ske_trace_str(&s->trace, "partition", p->cfg->name);
+    if (pname)
+        ske_trace_str(&s->trace, "process", pname);
+    else
+        ske_trace_raw(&s->trace, "process", "null");
+    ske_trace_int(&s->trace, "process_id", process);
+    ske_trace_str(&s->trace, "state", hm_state_name(state));
+    ske_trace_int(&s->trace, "error_code", hm_apex_error_code(err));
+    if (message && mlen)
+        ske_trace_strn(&s->trace, "message", message, mlen);
+    if (note)
+        ske_trace_str(&s->trace, "note", note);
+}
+
+static void trace_hm(ske_t *s, int64_t t, const part_t *p, hm_error_t err, hm_level_t level,
+                     hm_action_t action, hm_state_t state, int32_t process, const char *pname,
+                     const char *message, size_t mlen, const char *note)
+{
+    trace_hm_fields(s, t, p, err, level, action, state, process, pname, message, mlen, note);
+    ske_trace_end(&s->trace);
+}
+
+static int spawn(ske_t *s, part_t *p, char *err, size_t errlen);
+
+/* A partition-level action of the Partition HM table (ARINC 653 Part 1, 2.4.2). */
+static int apply_partition_action(ske_t *s, part_t *p, hm_action_t action, int64_t t, char *err,
+                                  size_t errlen)
+{
+    uint32_t cur = p->ctl ? atomic_load(&p->ctl->mode) : SKE_MODE_NORMAL;
+    switch (action) {
+    case HM_ACT_IDLE:
+        kill_partition(p);
+        p->state = PS_IDLE;
+        trace_mode(s, p, t, SKE_MODE_IDLE, cur, "health monitor");
+        return SKE_OK;
+    case HM_ACT_WARM_START:
+    case HM_ACT_COLD_START: {
+        uint32_t mode = action == HM_ACT_WARM_START ? SKE_MODE_WARM_START : SKE_MODE_COLD_START;
+        kill_partition(p);
+        trace_mode(s, p, t, mode, cur, "health monitor");
+        p->start_condition = 3; /* HM_PARTITION_RESTART */
+        p->initial_mode = mode;
+        p->restarts++;
+        p->state = PS_NOT_STARTED;
+        return spawn(s, p, err, errlen);
+    }
+    default:
+        return SKE_OK;
+    }
+}
+
+/* Decides and applies what an error detected at partition or module level leads to. The
+ * level comes from the SKE's own copy of the System HM table, never from the partition. */
+static int hm_handle(ske_t *s, part_t *p, int64_t t, hm_error_t e, hm_state_t state, int32_t process,
+                     const char *pname, const char *msg, size_t mlen, bool fatal, char *err,
+                     size_t errlen)
+{
+    hm_level_t level = hm_level_of(&s->cfg->hm, state, e);
+    const char *note = NULL;
+    if (level == HM_LEVEL_PROCESS) {
+        level = HM_LEVEL_PARTITION; /* no error handler could take it: the standard escalates */
+        note = "no process-level handling possible: escalated to the partition level";
+    }
+    if (level == HM_LEVEL_MODULE) {
+        hm_action_t a = hm_module_action(&s->cfg->hm, state, e);
+        trace_hm(s, t, p, e, level, a, state, process, pname, msg, mlen, note);
+        if (a == HM_ACT_SHUTDOWN)
+            s->hm_shutdown = true;
+        else if (a == HM_ACT_RESET)
+            s->hm_reset = true;
+        else if (fatal)
+            return apply_partition_action(s, p, HM_ACT_IDLE, t, err, errlen);
+        return SKE_OK;
+    }
+    hm_action_t a = hm_partition_action(&p->cfg->hm, state, e);
+    if (a == HM_ACT_IGNORE && fatal && alive(p)) {
+        /* The failed context cannot go on: ignoring would leave the partition hung. */
+        note = "IGNORE requested, but the failed initialisation cannot go on: the partition is idled";
+        a = HM_ACT_IDLE;
+    }
+    trace_hm(s, t, p, e, level, a, state, process, pname, msg, mlen, note);
+    return apply_partition_action(s, p, a, t, err, errlen);
+}
+
+/* An error the partition posted (partition or module level). Every field is checked. */
+static int hm_take_post(ske_t *s, part_t *p, int64_t t, char *err, size_t errlen)
+{
+    ske_ctl_t *c = p->ctl;
+    uint32_t seq = atomic_load(&c->hm_seq);
+    if (seq == atomic_load(&c->hm_ack))
+        return SKE_OK;
+    hm_error_t e = (hm_error_t)c->hm_error;
+    hm_state_t st = (hm_state_t)c->hm_state;
+    char pname[SKE_NAME_MAX], msg[SKE_EVENT_TEXT];
+    memcpy(pname, c->hm_process_name, sizeof pname);
+    pname[sizeof pname - 1] = '\0';
+    size_t mlen = c->hm_len < sizeof msg ? c->hm_len : sizeof msg;
+    memcpy(msg, c->hm_message, mlen);
+    int32_t process = c->hm_process;
+    bool fatal = c->hm_fatal != 0;
+    atomic_store(&c->hm_ack, seq); /* the partition goes on once the action is decided */
+    if (!hm_error_name(e) || !hm_state_name(st) || e == HM_ERR_WINDOW_OVERRUN || e == HM_ERR_PARTITION_EXIT)
+        return SKE_OK; /* not an error a partition can report */
+    return hm_handle(s, p, t, e, st, process, process > 0 ? pname : NULL, msg, mlen, fatal, err, errlen);
+}
+
+/* Applies a pending module RESET: every partition starts again (ARINC 653 Part 1, 2.4.2). */
+static int hm_module_reset(ske_t *s, int64_t t, char *err, size_t errlen)
+{
+    s->hm_reset = false;
+    for (int i = 0; i < s->cfg->n_partitions; i++) {
+        part_t *p = &s->parts[i];
+        uint32_t cur = p->ctl ? atomic_load(&p->ctl->mode) : SKE_MODE_IDLE;
+        kill_partition(p);
+        trace_mode(s, p, t, SKE_MODE_COLD_START, cur, "module reset");
+        p->start_condition = 2; /* HM_MODULE_RESTART */
+        p->initial_mode = SKE_MODE_COLD_START;
+        p->restarts++;
+        p->state = PS_NOT_STARTED;
+        int rc = spawn(s, p, err, errlen);
+        if (rc != SKE_OK)
+            return rc;
+    }
+    return SKE_OK;
 }
 
 /* ---- one window ----------------------------------------------------------------------- */
@@ -633,6 +791,18 @@ static void drain_events(ske_t *s, part_t *p, int64_t win_start, int64_t win_end
             ske_trace_int(&s->trace, "process", e.a);
             ske_trace_strn(&s->trace, "text", e.text, len);
             break;
+        case SKE_EV_HM: {
+            /* Decided in the partition: its error handler takes the error. */
+            hm_error_t he = (hm_error_t)e.a;
+            if (!hm_error_name(he) || len < SKE_NAME_MAX)
+                continue;
+            char pname[SKE_NAME_MAX];
+            memcpy(pname, e.text, sizeof pname);
+            pname[sizeof pname - 1] = '\0';
+            trace_hm_fields(s, t, p, he, HM_LEVEL_PROCESS, HM_ACT_ERROR_HANDLER, HM_STATE_PROCESS,
+                            e.b, pname, e.text + SKE_NAME_MAX, len - SKE_NAME_MAX, NULL);
+            break;
+        }
         case SKE_EV_PROCESS:
             ske_trace_begin(&s->trace, t, p->cfg->name, "process");
             ske_trace_int(&s->trace, "process", e.a);
@@ -681,6 +851,34 @@ static int handle_mode_request(ske_t *s, part_t *p, int64_t t, char *err, size_t
         p->restarts++;
         p->state = PS_NOT_STARTED;
         return spawn(s, p, err, errlen);
+    }
+    return SKE_OK;
+}
+
+/* A partition whose process ended without being asked to: PARTITION_EXIT. */
+static int judge_exits(ske_t *s, int64_t t, char *err, size_t errlen)
+{
+    for (int i = 0; i < s->cfg->n_partitions; i++) {
+        part_t *p = &s->parts[i];
+        if (!p->exit_to_judge)
+            continue;
+        p->exit_to_judge = false;
+        int rc = SKE_OK;
+        if (p->ctl)
+            rc = hm_take_post(s, p, t, err, errlen); /* what it reported before it ended */
+        if (rc != SKE_OK)
+            return rc;
+        if (p->state != PS_EXITED && p->state != PS_CRASHED)
+            continue; /* the health monitor already idled or restarted it */
+        char msg[64];
+        int n = p->state == PS_CRASHED
+                    ? snprintf(msg, sizeof msg, "killed by SIG%s",
+                               sigabbrev_np(p->exit_code) ? sigabbrev_np(p->exit_code) : "?")
+                    : snprintf(msg, sizeof msg, "exited with status %d", p->exit_code);
+        rc = hm_handle(s, p, t, HM_ERR_PARTITION_EXIT, partition_state(p), 0, NULL, msg,
+                       (size_t)n, false, err, errlen);
+        if (rc != SKE_OK)
+            return rc;
     }
     return SKE_OK;
 }
@@ -789,6 +987,7 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
      * the window's end. */
     if (granted && p->ctl)
         drain_events(s, p, start, end);
+    int rc = SKE_OK;
     if (r == W_OVERRUN) {
         ske_trace_begin(&s->trace, end, "ske", "overrun");
         ske_trace_str(&s->trace, "partition", p->cfg->name);
@@ -800,6 +999,18 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
     }
     if (granted && p->ctl)
         transfer_queues(s, p, end);
+    if (r == W_YIELD && alive(p))
+        rc = hm_take_post(s, p, end, err, errlen);
+    if (rc == SKE_OK && r == W_OVERRUN && alive(p)) {
+        char msg[80];
+        int n = snprintf(msg, sizeof msg, "window %d kept past its end (budget %lld ns)", w->id,
+                         (long long)w->duration_ns);
+        /* IGNORE leaves it stopped until its next window; IDLE or a restart end it now. */
+        rc = hm_handle(s, p, end, HM_ERR_WINDOW_OVERRUN, partition_state(p), 0, NULL, msg,
+                       (size_t)n, false, err, errlen);
+    }
+    if (rc == SKE_OK)
+        rc = judge_exits(s, end, err, errlen);
     s->cur_partition = -1;
     ske_trace_begin(&s->trace, end, "ske", "window_end");
     ske_trace_str(&s->trace, "partition", p->cfg->name);
@@ -814,6 +1025,8 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
         }
     }
     ske_trace_end(&s->trace);
+    if (rc != SKE_OK)
+        return rc;
     if (r == W_YIELD && alive(p))
         return handle_mode_request(s, p, end, err, errlen);
     return SKE_OK;
@@ -947,7 +1160,8 @@ static void write_stats(ske_t *s, double wall_s)
             fputs("null", f);
         fprintf(f, ",\"cpu_outside_windows_ns_max\":%" PRId64 "}", p->cpu_outside_max_ns);
     }
-    fputs("],\"windows\":[", f);
+    fprintf(f, "],\"hm_events\":%llu", (unsigned long long)s->hm_events);
+    fputs(",\"windows\":[", f);
     for (int i = 0; i < m->n_windows; i++) {
         const ske_window_cfg_t *w = &m->windows[i];
         fprintf(f, "%s{\"window\":%d,\"partition\":", i ? "," : "", w->id);
@@ -1000,8 +1214,13 @@ int ske_run(ske_t *s, char *err, size_t errlen)
     ske_slot_t slot;
     for (ske_plan_first(m, &slot); s->opts.frames < 0 || slot.frame < s->opts.frames;
          ske_plan_next(m, &slot)) {
-        if (s->stop_signal)
+        if (s->stop_signal || s->hm_shutdown)
             break;
+        if (slot.index == 0 && s->hm_reset) {
+            rc = hm_module_reset(s, slot.start_ns, err, errlen);
+            if (rc != SKE_OK)
+                break;
+        }
         rc = run_window(s, &slot, err, errlen);
         if (rc != SKE_OK)
             break;
@@ -1014,6 +1233,8 @@ int ske_run(ske_t *s, char *err, size_t errlen)
         snprintf(s->exit_reason, sizeof s->exit_reason, "error");
     else if (s->stop_signal)
         snprintf(s->exit_reason, sizeof s->exit_reason, "signal");
+    else if (s->hm_shutdown)
+        snprintf(s->exit_reason, sizeof s->exit_reason, "hm_shutdown");
 done:
     for (int i = 0; i < m->n_partitions; i++)
         kill_partition(&s->parts[i]);

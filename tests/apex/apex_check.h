@@ -91,6 +91,18 @@ static inline const char *deadline_name(DEADLINE_TYPE d)
     return enum_name(names, 2, d);
 }
 
+static inline const char *empty_indicator_name(EMPTY_INDICATOR_TYPE e)
+{
+    static const char *const names[] = {"EMPTY", "OCCUPIED"};
+    return enum_name(names, 2, e);
+}
+
+static inline const char *event_state_name(EVENT_STATE_TYPE s)
+{
+    static const char *const names[] = {"DOWN", "UP"};
+    return enum_name(names, 2, s);
+}
+
 static inline void check_str(const char *name, const char *expect, const char *got)
 {
     report("CHECK %s expect=%s got=%s", name, expect, got);
@@ -185,6 +197,35 @@ static inline SYSTEM_TIME_TYPE now_ns(void)
     GET_TIME(&t, &rc);
     setup_rc("GET_TIME", rc);
     return t;
+}
+
+/* The state of a process by identifier, as its name (a set-up step). */
+static inline const char *process_state_name(PROCESS_ID_TYPE id)
+{
+    PROCESS_STATUS_TYPE st;
+    memset(&st, 0x5A, sizeof st);
+    RETURN_CODE_TYPE rc;
+    GET_PROCESS_STATUS(id, &st, &rc);
+    setup_rc("GET_PROCESS_STATUS", rc);
+    return state_name(st.PROCESS_STATE);
+}
+
+/* What happened in which order, as processes record it: "a,b,c" (trail_add, then a check
+ * on trail; trail_reset starts again). */
+static char trail[256] __attribute__((unused));
+
+static inline void trail_reset(void) { trail[0] = '\0'; }
+
+static inline void trail_add(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static inline void trail_add(const char *fmt, ...)
+{
+    size_t n = strlen(trail);
+    if (n && n < sizeof trail - 1)
+        trail[n++] = ',';
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(trail + n, sizeof trail - n, fmt, ap);
+    va_end(ap);
 }
 
 /* Ends the initialisation process; reports if SET_PARTITION_MODE ever returns. */

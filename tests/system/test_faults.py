@@ -223,43 +223,55 @@ def test_next_window_does_not_wait_for_the_faulty_partition_to_stop(ske_binary, 
 
 
 @pytest.mark.parametrize(
-    ("arguments", "at", "exit_fields", "state", "exit_status"),
+    ("arguments", "at", "exit_fields", "hm_error", "hm_process"),
     [
-        ("segv 5", 5, {"status": "crashed", "signal": "SEGV"}, "crashed", signal.SIGSEGV),
-        ("exit 3 3", 3, {"status": "exited", "code": 3}, "exited", 3),
+        # A fault is caught inside the partition and reported; with the default tables it is
+        # handled at partition level by IDLE. The process does not die: no partition_exit.
+        ("segv 5", 5, None, "MEMORY_VIOLATION", "work"),
+        # A process that ends without being asked to: the SKE sees it, PARTITION_EXIT.
+        ("exit 3 3", 3, {"status": "exited", "code": 3}, "PARTITION_EXIT", None),
     ],
     ids=["crash", "exit"],
 )
-def test_partition_that_ends_is_reported_once_and_the_others_keep_going(
-        run_ske, tmp_path, split_windows, fault_free, arguments, at, exit_fields, state,
-        exit_status):
+def test_partition_that_fails_is_reported_once_idled_and_the_others_keep_going(
+        run_ske, tmp_path, split_windows, fault_free, arguments, at, exit_fields, hm_error,
+        hm_process):
     run = run_ske(fault_module(tmp_path, arguments), frames=FRAMES)
     assert run.returncode == 0, run.stderr
     trace = split_windows(run.events)
 
-    (ended,) = run.of_kind("partition_exit")
-    assert ended["partition"] == FAULTY
-    assert {k: ended[k] for k in exit_fields} == exit_fields
-    # It ended in the window where it reached the fault: its first window of frame `at`.
+    exits = run.of_kind("partition_exit")
+    if exit_fields is None:
+        assert exits == []
+    else:
+        (ended,) = exits
+        assert ended["partition"] == FAULTY
+        assert {k: ended[k] for k in exit_fields} == exit_fields
+    # One health-monitor decision, at the end of the window where the fault happened: its
+    # first window of frame `at`; the default Partition HM table idles the partition.
+    (hm,) = run.of_kind("hm")
+    assert (hm["error"], hm["level"], hm["action"], hm["partition"]) == (
+        hm_error, "PARTITION", "IDLE", FAULTY)
+    assert hm["process"] == hm_process
     faulty = trace.of_partition(FAULTY)
-    (where,) = [w for w in faulty if ended in w.inside]
-    assert (where.frame, where.window) == (at, faulty[0].window)
-    assert where.start_ns <= ended["t_ns"] <= where.end_ns
-    assert where.end["yielded"] is False
+    (where,) = [w for w in faulty if (w.frame, w.window) == (at, faulty[0].window)]
+    assert hm["t_ns"] == where.end_ns
+    (idle,) = run.of_kind("mode", partition=FAULTY, mode="IDLE")
+    assert idle["reason"] == "health monitor" and idle["t_ns"] == where.end_ns
     assert run.app_messages(FAULTY)[-1] == f"fault {arguments.split()[0]} at release {at}"
     for w in faulty:
         if (w.frame, w.window) <= (where.frame, where.window):
             assert "partition_state" not in w.start, w.start
         else:
             # Later windows still come, empty, and say why.
-            assert w.start["partition_state"] == state, w.start
+            assert w.start["partition_state"] == "idle", w.start
             assert w.inside == [] and "yielded" not in w.end, w
 
     assert_others_on_time(run, trace)
     assert about_others(run.events) == about_others(fault_free.events)
     stats = {p["name"]: p for p in run.stats["partitions"]}
-    assert stats[FAULTY]["state"] == state
-    assert stats[FAULTY]["exit_status"] == exit_status
+    assert stats[FAULTY]["state"] == "idle"
+    assert run.stats["hm_events"] == 1
 
 
 # ---- (d) partitions that cannot start ----------------------------------------------------

@@ -11,12 +11,14 @@
 #include <time.h>
 
 #define SKE_ABI_MAGIC 0x53414d49u /* "IMAS" */
-#define SKE_ABI_VERSION 1u
+#define SKE_ABI_VERSION 2u
 
 #define SKE_NAME_MAX 32 /* names carry at most 31 characters + NUL (ARINC allows 30) */
 #define SKE_MAX_PORTS 64 /* per partition */
 #define SKE_EVENT_RING 256 /* partition → SKE trace events per window, power of two */
 #define SKE_EVENT_TEXT 128
+#define SKE_HM_STATES 4 /* hm_state_t values */
+#define SKE_HM_ERRORS 11 /* hm_error_t values, 0 unused */
 
 /* Environment variable naming the control block's file descriptor in a partition. */
 #define SKE_ENV_CTL_FD "IMA_SKE_CTL_FD"
@@ -46,6 +48,8 @@ typedef enum {
     SKE_EV_PORT_VALIDITY = 2, /* a = port index, b = new validity (0 invalid, 1 valid) */
     SKE_EV_APP_MESSAGE = 3, /* a = process id (0 = initialisation), text = message */
     SKE_EV_PROCESS = 4, /* a = process id, b = ske_proc_event_t, text = process name */
+    SKE_EV_HM = 5, /* process-level error: a = hm_error_t, b = failed process id,
+                      text = ske_hm_text_t (process name, then the message) */
 } ske_event_kind_t;
 
 typedef enum {
@@ -126,6 +130,22 @@ typedef struct {
     _Atomic uint32_t ev_head; /* written by the partition */
     _Atomic uint32_t ev_tail; /* written by the SKE */
     _Atomic uint32_t ev_dropped; /* events lost because the ring was full */
+
+    /* Health monitoring. The System HM table (hm_level_t per system state and error) lets
+     * the partition decide process-level errors at once; errors at partition or module level
+     * are posted here for the SKE, which acts when the partition hands the CPU back. */
+    uint8_t hm_level[SKE_HM_STATES][SKE_HM_ERRORS];
+    _Atomic uint32_t hm_seq; /* partition: incremented when it posts an error */
+    _Atomic uint32_t hm_ack; /* SKE: the hm_seq it has acted on */
+    uint32_t hm_error; /* hm_error_t */
+    uint32_t hm_level_posted; /* hm_level_t */
+    uint32_t hm_state; /* hm_state_t */
+    uint32_t hm_fatal; /* the reporting context cannot go on (a fault in initialisation) */
+    int32_t hm_process; /* failed process id, 0 = the initialisation process */
+    uint32_t hm_len;
+    char hm_process_name[SKE_NAME_MAX];
+    char hm_message[SKE_EVENT_TEXT];
+    int64_t hm_t_ns;
     uint32_t pad1;
     ske_event_t ev[SKE_EVENT_RING];
 } ske_ctl_t;

@@ -9,6 +9,10 @@
 #include "apex_partition.h"
 #include "apex_sampling.h"
 #include "apex_queuing.h"
+#include "apex_buffer.h"
+#include "apex_blackboard.h"
+#include "apex_semaphore.h"
+#include "apex_event.h"
 #include "apex_error.h"
 
 #endif /* ARINC653_H */

@@ -49,6 +49,40 @@ extern void START(
 
 extern void STOP_SELF(void);
 
+extern void STOP(
+    /*in */ PROCESS_ID_TYPE PROCESS_ID,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+extern void SUSPEND_SELF(
+    /*in */ SYSTEM_TIME_TYPE TIME_OUT,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+extern void SUSPEND(
+    /*in */ PROCESS_ID_TYPE PROCESS_ID,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+extern void RESUME(
+    /*in */ PROCESS_ID_TYPE PROCESS_ID,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+extern void SET_PRIORITY(
+    /*in */ PROCESS_ID_TYPE PROCESS_ID,
+    /*in */ PRIORITY_TYPE PRIORITY,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+extern void DELAYED_START(
+    /*in */ PROCESS_ID_TYPE PROCESS_ID,
+    /*in */ SYSTEM_TIME_TYPE DELAY_TIME,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+extern void LOCK_PREEMPTION(
+    /*out*/ LOCK_LEVEL_TYPE *LOCK_LEVEL,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+extern void UNLOCK_PREEMPTION(
+    /*out*/ LOCK_LEVEL_TYPE *LOCK_LEVEL,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
 extern void GET_MY_ID(
     /*out*/ PROCESS_ID_TYPE *PROCESS_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);

@@ -16,4 +16,8 @@ extern void GET_TIME(
     /*out*/ SYSTEM_TIME_TYPE *SYSTEM_TIME,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
 
+extern void REPLENISH(
+    /*in */ SYSTEM_TIME_TYPE BUDGET_TIME,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
 #endif /* APEX_TIME */

@@ -12,6 +12,10 @@
 #define SYSTEM_LIMIT_NUMBER_OF_PROCESSES 128 /* partition scope */
 #define SYSTEM_LIMIT_NUMBER_OF_SAMPLING_PORTS 64 /* partition scope */
 #define SYSTEM_LIMIT_NUMBER_OF_QUEUING_PORTS 64 /* partition scope */
+#define SYSTEM_LIMIT_NUMBER_OF_BUFFERS 256 /* partition scope */
+#define SYSTEM_LIMIT_NUMBER_OF_BLACKBOARDS 256 /* partition scope */
+#define SYSTEM_LIMIT_NUMBER_OF_SEMAPHORES 256 /* partition scope */
+#define SYSTEM_LIMIT_NUMBER_OF_EVENTS 256 /* partition scope */
 
 /* Base APEX types: 8-bit unsigned, 32-bit signed, 32-bit unsigned, 64-bit signed. */
 typedef uint8_t APEX_BYTE;

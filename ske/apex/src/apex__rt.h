@@ -17,6 +17,12 @@ typedef enum {
     WAIT_PERIOD, /* PERIODIC_WAIT, or a periodic process waiting for its first release */
     WAIT_QRECV, /* RECEIVE_QUEUING_MESSAGE on an empty queue */
     WAIT_QSEND, /* SEND_QUEUING_MESSAGE on a full queue */
+    WAIT_SUSPEND, /* SUSPEND_SELF */
+    WAIT_BUF_SEND, /* SEND_BUFFER on a full buffer */
+    WAIT_BUF_RECV, /* RECEIVE_BUFFER on an empty buffer */
+    WAIT_BB_READ, /* READ_BLACKBOARD on an empty blackboard */
+    WAIT_SEM, /* WAIT_SEMAPHORE at value 0 */
+    WAIT_EVT, /* WAIT_EVENT on an event that is DOWN */
 } apex_wait_t;
 
 typedef struct {
@@ -33,15 +39,30 @@ typedef struct {
     RETURN_CODE_TYPE wait_rc;
     uint64_t ready_order; /* FIFO order within a priority */
     bool start_pending; /* START called before NORMAL mode */
+    int64_t start_delay; /* DELAYED_START called before NORMAL mode */
+    bool suspended; /* SUSPENDed by another process: WAITING until RESUME, its own wait or not */
+    int wait_obj; /* buffer, blackboard, semaphore or event index of those waits */
     /* Queuing wait arguments. */
     const APEX_BYTE *q_msg;
     MESSAGE_SIZE_TYPE q_len;
     APEX_BYTE *q_buf;
     MESSAGE_SIZE_TYPE *q_len_out;
+    bool deadline_missed; /* reported for the current release already */
     ucontext_t ctx;
     void *stack_map;
     size_t stack_map_size;
 } apex_proc_t;
+
+/* One error waiting for the error handler (GET_ERROR_STATUS). */
+typedef struct {
+    ERROR_CODE_TYPE code;
+    PROCESS_ID_TYPE failed;
+    SYSTEM_ADDRESS_TYPE address;
+    MESSAGE_SIZE_TYPE len;
+    APEX_BYTE message[MAX_ERROR_MESSAGE_SIZE];
+} apex_error_t;
+
+#define APEX_ERROR_QUEUE 32
 
 typedef struct {
     bool created;
@@ -64,7 +85,16 @@ typedef struct {
     apex_proc_t *current; /* NULL while the initialisation (main) process runs */
     ucontext_t sched_ctx;
     uint64_t order;
+    LOCK_LEVEL_TYPE lock_level; /* LOCK_PREEMPTION depth: while > 0 only lock_owner runs */
+    apex_proc_t *lock_owner;
     apex_port_t ports[SKE_MAX_PORTS];
+    /* Health monitoring: the error handler (above every process's priority) and the errors
+     * it has yet to read. */
+    bool has_eh;
+    apex_proc_t eh;
+    apex_error_t errors[APEX_ERROR_QUEUE];
+    uint32_t err_head, err_tail;
+    uint32_t errors_lost;
 } apex_rt_t;
 
 /* t + d for d ≥ 0, or false when the sum passes the end of the 64-bit clock (the standard's
@@ -93,6 +123,9 @@ RETURN_CODE_TYPE apex__block(apex_proc_t *p);
 void apex__preempt_check(void);
 /* Marks a process ready, at the back of its priority's FIFO. */
 void apex__make_ready(apex_proc_t *p);
+/* Releases a process DELAYED_STARTed before NORMAL mode, as NORMAL mode begins at `now`
+ * with the partition's first period start at `first_release` (process.c). */
+void apex__release_delayed(apex_proc_t *p, int64_t now, int64_t first_release);
 /* Enters NORMAL mode from the initialisation process: never returns. */
 void apex__enter_normal(void) __attribute__((noreturn));
 /* Hands the CPU back to the SKE until the next window. */
@@ -105,6 +138,18 @@ int apex__port_index(APEX_INTEGER id, uint32_t kind);
 int apex__port_by_name(const char *name, uint32_t kind);
 /* Maps configured port k (read-only for destinations); false if it cannot be mapped. */
 bool apex__port_map(int k);
+/* Whether the current process may wait: not the initialisation process, not the error
+ * handler, not while preemption is locked (ARINC 653 Part 1: blocking services return
+ * INVALID_MODE for all three). */
+bool apex__may_block(void);
+/* Brackets a copy from or to memory the caller named: a fault inside is an APEX service
+ * given an invalid address, an ILLEGAL_REQUEST rather than a MEMORY_VIOLATION. */
+void apex__user_copy(bool on);
+/* Health monitoring hooks of the run-time (hm.c). */
+void apex__hm_init(void);
+void apex__hm_check_deadlines(void);
+/* The ready process to run next, the error handler first. */
+apex_proc_t *apex__pick(void);
 /* Completes port waits whose condition now holds (scheduler side). */
 void apex__service_port_waiters(void);
 /* Messages waiting in a queuing port, and whether any process waits on it. */

@@ -14,6 +14,8 @@ void REPORT_APPLICATION_MESSAGE(
         return;
     }
     PROCESS_ID_TYPE id = apex__rt.current ? apex__rt.current->id : 0;
+    apex__user_copy(true);
     apex__event(SKE_EV_APP_MESSAGE, id, 0, MESSAGE_ADDR, (uint32_t)LENGTH);
+    apex__user_copy(false);
     *RETURN_CODE = NO_ERROR;
 }

@@ -40,7 +40,9 @@ static RETURN_CODE_TYPE receive_now(int k, APEX_BYTE *buf, MESSAGE_SIZE_TYPE *le
     uint32_t tail = atomic_load(&d->rx_tail);
     uint32_t l;
     int64_t t;
+    apex__user_copy(true);
     ske_queue_peek(qhdr(k), d->max_size, d->max_nb, tail, buf, &l, &t);
+    apex__user_copy(false);
     atomic_store(&d->rx_tail, tail + 1);
     *len = (MESSAGE_SIZE_TYPE)l;
     uint32_t ovf = atomic_load(&qhdr(k)->overflows);
@@ -56,8 +58,11 @@ static RETURN_CODE_TYPE receive_now(int k, APEX_BYTE *buf, MESSAGE_SIZE_TYPE *le
 static bool send_now(int k, const APEX_BYTE *msg, MESSAGE_SIZE_TYPE len)
 {
     const ske_port_desc_t *d = &apex__rt.ctl->ports[k];
-    return ske_queue_push(qhdr(k), d->max_size, d->max_nb, atomic_load(&qhdr(k)->tail), msg,
-                          (uint32_t)len, apex__now());
+    apex__user_copy(true);
+    bool ok = ske_queue_push(qhdr(k), d->max_size, d->max_nb, atomic_load(&qhdr(k)->tail), msg,
+                             (uint32_t)len, apex__now());
+    apex__user_copy(false);
+    return ok;
 }
 
 /* The waiter to serve next: FIFO or priority order, as the port's discipline says. */
@@ -183,8 +188,8 @@ void SEND_QUEUING_MESSAGE(
         return;
     }
     apex_proc_t *p = apex__rt.current;
-    if (!p) {
-        *RETURN_CODE = INVALID_MODE; /* the initialisation process cannot wait */
+    if (!apex__may_block()) {
+        *RETURN_CODE = INVALID_MODE; /* the initialisation process, the error handler */
         return;
     }
     p->wait = WAIT_QSEND;
@@ -228,8 +233,8 @@ void RECEIVE_QUEUING_MESSAGE(
         return;
     }
     apex_proc_t *p = apex__rt.current;
-    if (!p) {
-        *RETURN_CODE = INVALID_MODE;
+    if (!apex__may_block()) {
+        *RETURN_CODE = INVALID_MODE; /* the initialisation process, the error handler */
         return;
     }
     MESSAGE_SIZE_TYPE len = 0;

@@ -93,6 +93,7 @@ __attribute__((constructor)) static void apex_attach(void)
         prctl(PR_SET_TIMERSLACK, 1UL); /* time-outs inside a window wake on time */
     rt->mode = (OPERATING_MODE_TYPE)rt->ctl->initial_mode;
     rt->seen_grant = 0;
+    apex__hm_init();
     atomic_store(&rt->ctl->ready, 1);
     ske_futex_wake(&rt->ctl->ready);
     wait_grant();
@@ -167,15 +168,24 @@ void apex__event(uint32_t kind, int32_t a, int32_t b, const void *text, uint32_t
 
 void apex__make_ready(apex_proc_t *p)
 {
-    p->state = READY;
     p->wait = WAIT_NONE;
+    if (p->suspended) {
+        p->state = WAITING; /* its wait is over, its suspension lasts until RESUME */
+        return;
+    }
+    p->state = READY;
     p->ready_order = ++apex__rt.order;
 }
 
-/* Highest current priority first, FIFO (time it became ready) within a priority. */
+/* Highest current priority first, FIFO (time it became ready) within a priority; the error
+ * handler before any process (ARINC 653 Part 1: it has the highest priority). */
 static apex_proc_t *pick(void)
 {
     apex_rt_t *rt = &apex__rt;
+    if (rt->has_eh && rt->eh.state == READY)
+        return &rt->eh;
+    if (rt->lock_level > 0 && rt->lock_owner && rt->lock_owner->state == READY)
+        return rt->lock_owner; /* preemption is locked: its holder goes on */
     apex_proc_t *best = NULL;
     for (int i = 0; i < rt->n_procs; i++) {
         apex_proc_t *p = &rt->procs[i];
@@ -188,9 +198,18 @@ static apex_proc_t *pick(void)
     return best;
 }
 
+apex_proc_t *apex__pick(void) { return pick(); }
+
+bool apex__may_block(void)
+{
+    const apex_rt_t *rt = &apex__rt;
+    return rt->current && rt->current != &rt->eh && rt->lock_level == 0;
+}
+
 static void release(apex_proc_t *p)
 {
     if (p->wait == WAIT_PERIOD) {
+        p->deadline_missed = false; /* a new release, a new deadline */
         int64_t r = p->wake_at;
         p->deadline_time = INFINITE_TIME_VALUE;
         if (p->attr.TIME_CAPACITY != INFINITE_TIME_VALUE &&
@@ -263,6 +282,7 @@ static void __attribute__((noreturn)) scheduler_loop(void)
         apex__sync();
         release_due();
         apex__service_port_waiters();
+        apex__hm_check_deadlines();
         apex_proc_t *p = pick();
         if (p) {
             run(p);
@@ -294,7 +314,8 @@ void apex__preempt_check(void)
     if (!cur || rt->mode != NORMAL)
         return;
     apex_proc_t *p = pick();
-    if (p && p->cur_prio > cur->cur_prio) {
+    if (p && p != cur &&
+        (p == &rt->eh || (cur != &rt->eh && rt->lock_level == 0 && p->cur_prio > cur->cur_prio))) {
         /* The preempted process keeps its place: it has been ready the longest. */
         cur->state = READY;
         swapcontext(&cur->ctx, &rt->sched_ctx);
@@ -315,6 +336,10 @@ void apex__enter_normal(void)
         if (!p->start_pending)
             continue;
         p->start_pending = false;
+        if (p->start_delay > 0) {
+            apex__release_delayed(p, now, first_release); /* DELAYED_START (process.c) */
+            continue;
+        }
         if (p->attr.PERIOD == INFINITE_TIME_VALUE) {
             /* A deadline past the end of the clock is no deadline (the health monitor's
              * illegal-request report for it comes with the HM tables). */

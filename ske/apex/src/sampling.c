@@ -65,7 +65,9 @@ void WRITE_SAMPLING_MESSAGE(
         *RETURN_CODE = INVALID_MODE;
         return;
     }
+    apex__user_copy(true);
     ske_sampling_write(apex__rt.ports[k].mem, d->max_size, MESSAGE_ADDR, (uint32_t)LENGTH, apex__now());
+    apex__user_copy(false);
     *RETURN_CODE = NO_ERROR;
 }
 
@@ -90,7 +92,10 @@ void READ_SAMPLING_MESSAGE(
     }
     uint32_t len;
     int64_t t;
-    if (!ske_sampling_read(ap->mem, d->max_size, MESSAGE_ADDR, &len, &t)) {
+    apex__user_copy(true);
+    bool got = ske_sampling_read(ap->mem, d->max_size, MESSAGE_ADDR, &len, &t);
+    apex__user_copy(false);
+    if (!got) {
         *RETURN_CODE = NO_ACTION; /* no message was ever written */
         return;
     }

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* APEX time management: TIMED_WAIT, PERIODIC_WAIT, GET_TIME (ARINC 653 Part 1, 3.4.2). */
+/* APEX time management: TIMED_WAIT, PERIODIC_WAIT, GET_TIME, REPLENISH (ARINC 653 Part 1,
+ * 3.4.2). */
 #include "apex__rt.h"
 
 void TIMED_WAIT(
@@ -9,8 +10,8 @@ void TIMED_WAIT(
     apex_rt_t *rt = &apex__rt;
     apex__sync();
     apex_proc_t *p = rt->current;
-    if (!p) {
-        *RETURN_CODE = INVALID_MODE; /* the initialisation process cannot wait */
+    if (!apex__may_block()) {
+        *RETURN_CODE = INVALID_MODE; /* the initialisation process, the error handler */
         return;
     }
     int64_t wake;
@@ -35,7 +36,7 @@ void PERIODIC_WAIT(
 {
     apex__sync();
     apex_proc_t *p = apex__rt.current;
-    if (!p || p->attr.PERIOD == INFINITE_TIME_VALUE) {
+    if (!apex__may_block() || p->attr.PERIOD == INFINITE_TIME_VALUE) {
         *RETURN_CODE = INVALID_MODE;
         return;
     }
@@ -51,5 +52,39 @@ void GET_TIME(
 {
     apex__sync();
     *SYSTEM_TIME = apex__now();
+    *RETURN_CODE = NO_ERROR;
+}
+
+void REPLENISH(
+    /*in */ SYSTEM_TIME_TYPE BUDGET_TIME,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
+{
+    apex_rt_t *rt = &apex__rt;
+    apex__sync();
+    apex_proc_t *p = rt->current;
+    /* Nothing to replenish for the initialisation process, the error handler, or a process
+     * with no time capacity (no deadline). */
+    if (!p || p == &rt->eh || rt->mode != NORMAL || p->attr.TIME_CAPACITY == INFINITE_TIME_VALUE) {
+        *RETURN_CODE = NO_ACTION;
+        return;
+    }
+    if (BUDGET_TIME < INFINITE_TIME_VALUE) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    int64_t deadline = INFINITE_TIME_VALUE;
+    bool in_range = BUDGET_TIME == INFINITE_TIME_VALUE ||
+                    apex__time_add(apex__now(), BUDGET_TIME, &deadline);
+    if (p->attr.PERIOD != INFINITE_TIME_VALUE &&
+        (deadline == INFINITE_TIME_VALUE || !in_range || deadline > p->next_release)) {
+        *RETURN_CODE = INVALID_MODE; /* a periodic process's deadline stays before its next release */
+        return;
+    }
+    if (!in_range) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    p->deadline_time = deadline; /* now + BUDGET_TIME, or none for INFINITE_TIME_VALUE */
+    p->deadline_missed = false;
     *RETURN_CODE = NO_ERROR;
 }

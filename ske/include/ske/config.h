@@ -7,6 +7,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "hm/hm.h"
 #include "ske_abi.h"
 
 #define SKE_MAX_PARTITIONS 32
@@ -75,6 +76,7 @@ typedef struct {
     ske_port_cfg_t ports[SKE_MAX_PORTS];
     int n_processes;
     ske_process_cfg_t processes[SKE_MAX_PORTS];
+    hm_partition_table_t hm; /* its Partition HM table (defaults where none is given) */
     int line;
 } ske_partition_cfg_t;
 
@@ -114,6 +116,7 @@ typedef struct {
     ske_window_cfg_t windows[SKE_MAX_WINDOWS];
     int n_channels;
     ske_channel_cfg_t channels[SKE_MAX_CHANNELS];
+    hm_system_table_t hm; /* System and Module HM tables (defaults where none is given) */
 } ske_module_cfg_t;
 
 typedef struct {

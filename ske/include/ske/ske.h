@@ -33,6 +33,8 @@ void ske_request_stop(ske_t *ske, int signo);
 void ske_notify_child(ske_t *ske);
 /* The signal that stopped the run, or 0. */
 int ske_stop_signal(const ske_t *ske);
+/* Whether a module-level SHUTDOWN of the health monitor ended the run. */
+bool ske_shut_down_by_hm(const ske_t *ske);
 /* Kills any partition still alive and frees everything. */
 void ske_destroy(ske_t *ske);
 

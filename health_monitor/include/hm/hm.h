@@ -1,0 +1,83 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* ARINC 653 Part 1 health monitoring: the errors the emulator detects, the system states it
+ * distinguishes, and the three tables (System, Module, Partition) that decide at which level
+ * an error is handled and with which action. */
+#ifndef HM_HM_H
+#define HM_HM_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+/* Error identifiers (the ErrorIdentifier of the HM tables; implementation-defined in the
+ * standard). 1-8 are the APEX error codes as detected in a partition; 9 and 10 are what the
+ * SKE alone sees. 0 is unused so that a zeroed table entry is recognisably "not set". */
+typedef enum {
+    HM_ERR_DEADLINE_MISSED = 1, /* a process missed its deadline */
+    HM_ERR_APPLICATION_ERROR = 2, /* RAISE_APPLICATION_ERROR */
+    HM_ERR_NUMERIC_ERROR = 3, /* SIGFPE */
+    HM_ERR_ILLEGAL_REQUEST = 4, /* a system call the sandbox denies (SIGSYS) */
+    HM_ERR_STACK_OVERFLOW = 5, /* a write into a stack's guard page */
+    HM_ERR_MEMORY_VIOLATION = 6, /* SIGSEGV, SIGBUS outside a stack guard */
+    HM_ERR_HARDWARE_FAULT = 7, /* SIGILL */
+    HM_ERR_POWER_FAIL = 8, /* never detected in emulation; configurable for completeness */
+    HM_ERR_WINDOW_OVERRUN = 9, /* the partition kept the CPU past its window (DEADLINE_MISSED) */
+    HM_ERR_PARTITION_EXIT = 10, /* the partition's process ended without being asked to */
+    HM_ERR_COUNT = 11,
+} hm_error_t;
+
+/* System states of the System HM table (SystemState). */
+typedef enum {
+    HM_STATE_MODULE_INIT = 0, /* the SKE is starting the module */
+    HM_STATE_PARTITION_INIT = 1, /* the partition's initialisation (COLD_START, WARM_START) */
+    HM_STATE_PROCESS = 2, /* an ARINC process runs (NORMAL mode) */
+    HM_STATE_ERROR_HANDLER = 3, /* the partition's error handler runs */
+    HM_STATE_COUNT = 4,
+} hm_state_t;
+
+typedef enum { HM_LEVEL_MODULE = 0, HM_LEVEL_PARTITION = 1, HM_LEVEL_PROCESS = 2 } hm_level_t;
+
+typedef enum {
+    HM_ACT_IGNORE = 0,
+    HM_ACT_IDLE = 1, /* partition */
+    HM_ACT_WARM_START = 2, /* partition */
+    HM_ACT_COLD_START = 3, /* partition */
+    HM_ACT_SHUTDOWN = 4, /* module */
+    HM_ACT_RESET = 5, /* module */
+    HM_ACT_ERROR_HANDLER = 6, /* process level: the partition's error handler runs */
+} hm_action_t;
+
+/* The System HM table (level of each error in each state) and the Module HM table. */
+typedef struct {
+    uint8_t level[HM_STATE_COUNT][HM_ERR_COUNT];
+    uint8_t module_action[HM_STATE_COUNT][HM_ERR_COUNT];
+} hm_system_table_t;
+
+/* A Partition HM table. */
+typedef struct {
+    uint8_t action[HM_STATE_COUNT][HM_ERR_COUNT];
+} hm_partition_table_t;
+
+/* The tables a module without HM tables gets: every error at partition level; partition
+ * action IDLE (fail-stop), except a window overrun, IGNOREd (the partition is already stopped
+ * for the rest of its window); module action IGNORE. */
+void hm_system_defaults(hm_system_table_t *t);
+void hm_partition_defaults(hm_partition_table_t *t);
+
+hm_level_t hm_level_of(const hm_system_table_t *t, hm_state_t state, hm_error_t err);
+hm_action_t hm_module_action(const hm_system_table_t *t, hm_state_t state, hm_error_t err);
+hm_action_t hm_partition_action(const hm_partition_table_t *t, hm_state_t state, hm_error_t err);
+
+/* Names as the standard spells them (trace and configuration). NULL when out of range. */
+const char *hm_error_name(hm_error_t err);
+const char *hm_state_name(hm_state_t s);
+const char *hm_level_name(hm_level_t l);
+const char *hm_action_name(hm_action_t a);
+/* Parse a name; false if unknown. */
+bool hm_level_parse(const char *s, hm_level_t *out);
+bool hm_action_parse(const char *s, hm_action_t *out);
+bool hm_error_parse(const char *s, hm_error_t *out);
+
+/* The APEX ERROR_CODE_TYPE value reported to an error handler for an error identifier. */
+int hm_apex_error_code(hm_error_t err);
+
+#endif /* HM_HM_H */

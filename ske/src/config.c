@@ -248,7 +248,8 @@ static bool attr_seconds(loader_t *L, const xmlNode *n, const char *name, int64_
     if (!ske_parse_seconds(buf, ns)) {
         fail(L, n, "durations are decimal seconds",
              "%s='%s' is not a valid duration: expected decimal seconds such as 0.010, "
-             "at most 9 decimals", name, buf);
+             "at most 9 decimals and at most %lld s", name, buf,
+             (long long)(INT64_MAX / 1000000000LL - 10));
         return false;
     }
     return true;
@@ -376,7 +377,16 @@ static void schema_error(void *ctx, xmlErrorPtr err)
     if (attr_name_s && node)
         attr(node, attr_name_s, value, sizeof value);
     size_t an = attr_name_s ? strlen(attr_name_s) : 0;
-    if (attr_name_s && an > 7 && strcmp(attr_name_s + an - 7, "Seconds") == 0) {
+    bool value_error = strstr(msg, "is not a valid value") || strstr(msg, "[facet");
+    const char *max = strstr(msg, "maximum value allowed ('");
+    if (!value_error)
+        attr_name_s = NULL; /* a missing or unexpected attribute: the validator says it best */
+    if (attr_name_s && max) {
+        char lim[32] = "";
+        sscanf(max + strlen("maximum value allowed ('"), "%31[0-9]", lim);
+        diag_set(L->diag, L->m->path, line, elem, "numbers are within their range",
+                 "%s='%s' is too large: at most %s", attr_name_s, value, lim);
+    } else if (attr_name_s && an > 7 && strcmp(attr_name_s + an - 7, "Seconds") == 0) {
         diag_set(L->diag, L->m->path, line, elem, "durations are decimal seconds",
                  "%s='%s' is not a valid duration: expected decimal seconds such as 0.010, "
                  "at most 9 decimals", attr_name_s, value);
@@ -680,6 +690,40 @@ static void load_schedule(loader_t *L, const xmlNode *n)
                  "partition '%s' declares %lld ns per period but its windows give %lld ns per "
                  "period", p->name, (long long)declared_duration, (long long)(total / periods));
             return;
+        }
+        /* Every period of the partition gets the same window time (ARINC 653 Part 1, 2.3.1.3):
+         * a window belongs to the period its start falls in, and may not cross into the next. */
+        for (int64_t k = 0; k < periods && !L->failed; k++) {
+            int64_t lo = p->period_anchor_ns + k * p->period_ns, hi = lo + p->period_ns, in = 0;
+            for (int i = 0; i < m->n_windows; i++) {
+                const ske_window_cfg_t *win = &m->windows[i];
+                if (win->partition != pi)
+                    continue;
+                /* offsets before the anchor belong to the last period, wrapping the frame */
+                int64_t off = win->offset_ns < p->period_anchor_ns ? win->offset_ns + m->major_frame_ns
+                                                                   : win->offset_ns;
+                if (off < lo || off >= hi)
+                    continue;
+                if (off + win->duration_ns > hi) {
+                    L->failed = false;
+                    diag_set(L->diag, m->path, win->line, "Window_Schedule",
+                             "a window stays within its partition period",
+                             "window %d of partition '%s' starts at %lld ns and ends past the end "
+                             "of its partition period at %lld ns", win->id, p->name,
+                             (long long)win->offset_ns, (long long)(hi % m->major_frame_ns));
+                    L->failed = true;
+                    return;
+                }
+                in += win->duration_ns;
+            }
+            if (in != p->duration_ns) {
+                fail(L, ps, "every partition period gets the same window time",
+                     "partition '%s' gets %lld ns in its period starting at %lld ns but %lld ns "
+                     "per period on average (period %lld ns)", p->name, (long long)in,
+                     (long long)(lo % m->major_frame_ns), (long long)p->duration_ns,
+                     (long long)p->period_ns);
+                return;
+            }
         }
     }
 }

@@ -29,6 +29,9 @@ extern char **environ;
 #define HANG_FACTOR 20 /* emulated mode: a window may take this many times its length in wall */
 #define HANG_MIN_NS 2000000000LL /* time (at least 2 s) while using no CPU before it is cut */
 #define SAMPLE_LIMIT 2000000
+/* A partition that handed the CPU back has a few microseconds of system-call tail; more than
+ * this much CPU before its next window means it went on computing. */
+#define OUTSIDE_LIMIT_NS 2000000
 #define RT_SPIN_NS 200000 /* real-time mode: spin this long before a window starts */
 #define SYSTEM_MESSAGE_MAX (1u << 20) /* the largest MaxMessageSize the schema accepts */
 
@@ -90,6 +93,7 @@ struct ske {
     int cur_partition; /* partition holding the current window, -1 between windows */
     int64_t prev_yield_mono_ns; /* the previous window's yield, for the switch figure */
     uint8_t *xfer; /* one message, for queue transfers */
+    pid_t pid; /* the SKE's own process, for its partitions to check */
     bool hm_shutdown; /* a module-level SHUTDOWN: the run ends */
     bool hm_reset; /* a module-level RESET: every partition restarts at the next frame */
     uint64_t hm_events;
@@ -140,10 +144,13 @@ static void cpu_relax(void)
 
 static int memobj(const char *name, size_t size, void **mem)
 {
-    int fd = memfd_create(name, MFD_CLOEXEC);
+    int fd = memfd_create(name, MFD_CLOEXEC | MFD_ALLOW_SEALING);
     if (fd < 0)
         return -errno;
-    if (ftruncate(fd, (off_t)size) != 0) {
+    /* Sealed at its size: a partition holding a descriptor cannot shrink it under the SKE's
+     * mapping (the SKE would die of SIGBUS on its next access). */
+    if (ftruncate(fd, (off_t)size) != 0 ||
+        fcntl(fd, F_ADD_SEALS, F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_SEAL) != 0) {
         int e = errno;
         close(fd);
         return -e;
@@ -307,6 +314,7 @@ static void child_exec(ske_t *s, part_t *p, int errpipe, char **envp)
     sigaction(SIGINT, &dfl, NULL);
     sigaction(SIGTERM, &dfl, NULL);
     sigaction(SIGCHLD, &dfl, NULL);
+    sigaction(SIGPIPE, &dfl, NULL); /* the SKE ignores it; a partition gets the default */
     sigset_t none;
     sigemptyset(&none);
     sigprocmask(SIG_SETMASK, &none, NULL);
@@ -315,6 +323,8 @@ static void child_exec(ske_t *s, part_t *p, int errpipe, char **envp)
         dup2(devnull, 0);
         close(devnull);
     }
+    if (s->trace.f == stdout)
+        dup2(2, 1); /* keep the JSON-lines trace on standard output clean */
     /* Move every descriptor the partition gets above the target range, then into place:
      * 3 = control block, 4.. = its ports, then the exec-error pipe; close the rest. */
     int high[SKE_MAX_PORTS + 2];
@@ -331,13 +341,12 @@ static void child_exec(ske_t *s, part_t *p, int errpipe, char **envp)
     dup2(high[1 + n], 4 + n);
     fcntl(4 + n, F_SETFD, FD_CLOEXEC);
     close_range(5 + (unsigned)n, ~0U, 0);
-    if (getppid() == 1)
+    if (getppid() != s->pid)
         _exit(127); /* the SKE is already gone */
     execve(p->cfg->executable, p->cfg->argv, envp);
     int e = errno;
     ssize_t w = write(4 + n, &e, sizeof e);
     (void)w;
-    (void)s;
     _exit(127);
 }
 
@@ -480,6 +489,7 @@ static void reap(ske_t *s)
 static void kill_partition(part_t *p)
 {
     if (p->pid > 0) {
+        kill(-p->pid, SIGKILL); /* its process group: anything it may have started, too */
         kill(p->pid, SIGKILL);
         waitpid(p->pid, NULL, 0);
         p->pid = 0;
@@ -529,6 +539,22 @@ static void trace_hm(ske_t *s, int64_t t, const part_t *p, hm_error_t err, hm_le
 
 static int spawn(ske_t *s, part_t *p, char *err, size_t errlen);
 
+/* Starts a partition again. If that fails, the partition stays down and the trace says why:
+ * one partition's failed restart never stops the others. */
+static int respawn(ske_t *s, part_t *p, int64_t t)
+{
+    char why[512] = "";
+    if (spawn(s, p, why, sizeof why) == SKE_OK)
+        return SKE_OK;
+    kill_partition(p);
+    p->state = PS_CRASHED;
+    ske_trace_begin(&s->trace, t, "ske", "start_failed");
+    ske_trace_str(&s->trace, "partition", p->cfg->name);
+    ske_trace_str(&s->trace, "reason", why);
+    ske_trace_end(&s->trace);
+    return SKE_OK;
+}
+
 /* A partition-level action of the Partition HM table (ARINC 653 Part 1, 2.4.2). */
 static int apply_partition_action(ske_t *s, part_t *p, hm_action_t action, int64_t t, char *err,
                                   size_t errlen)
@@ -549,7 +575,7 @@ static int apply_partition_action(ske_t *s, part_t *p, hm_action_t action, int64
         p->initial_mode = mode;
         p->restarts++;
         p->state = PS_NOT_STARTED;
-        return spawn(s, p, err, errlen);
+        return respawn(s, p, t);
     }
     default:
         return SKE_OK;
@@ -624,16 +650,25 @@ static int hm_module_reset(ske_t *s, int64_t t, char *err, size_t errlen)
         p->initial_mode = SKE_MODE_COLD_START;
         p->restarts++;
         p->state = PS_NOT_STARTED;
-        int rc = spawn(s, p, err, errlen);
-        if (rc != SKE_OK)
-            return rc;
+        respawn(s, p, t);
     }
+    (void)err;
+    (void)errlen;
     return SKE_OK;
 }
 
 /* ---- one window ----------------------------------------------------------------------- */
 
 typedef enum { W_YIELD, W_OVERRUN, W_EXIT, W_STOP } wres_t;
+
+/* Why a window ended in an overrun (the trace's `cause`). */
+typedef enum {
+    OV_CPU_BUDGET, /* emulated: used the window's length in CPU time */
+    OV_WALL_LIMIT, /* emulated: held the window far longer in wall time without using CPU */
+    OV_WINDOW_END, /* real time: still running at the window's wall-clock end */
+} ov_cause_t;
+
+static const char *const ov_cause_names[] = {"cpu_budget", "wall_limit", "window_end"};
 
 
 static bool yielded(const part_t *p)
@@ -644,7 +679,8 @@ static bool yielded(const part_t *p)
 /* Waits for the partition to hand the CPU back. Emulated mode: the window's length is a
  * budget of CPU time (computation takes no emulated time, but it may not take unbounded
  * real time either). Real-time mode: the window ends at its wall-clock end. */
-static wres_t wait_yield(ske_t *s, part_t *p, int64_t budget_ns, int64_t end_mono_ns, int64_t cpu0)
+static wres_t wait_yield(ske_t *s, part_t *p, int64_t budget_ns, int64_t end_mono_ns, int64_t cpu0,
+                         ov_cause_t *cause)
 {
     int64_t t0 = ske_mono_ns();
     /* Most windows of a light partition end within microseconds: notice that at once. */
@@ -669,15 +705,21 @@ static wres_t wait_yield(ske_t *s, part_t *p, int64_t budget_ns, int64_t end_mon
         int64_t wait_ns;
         if (s->time_mode == SKE_TIME_REALTIME) {
             wait_ns = end_mono_ns - now;
-            if (wait_ns <= 0)
+            if (wait_ns <= 0) {
+                *cause = OV_WINDOW_END;
                 return W_OVERRUN;
+            }
         } else {
             int64_t used = cpu0 >= 0 ? cpu_now(p) - cpu0 : now - t0;
-            if (used >= budget_ns)
+            if (used >= budget_ns) {
+                *cause = OV_CPU_BUDGET;
                 return W_OVERRUN;
+            }
             int64_t hang = budget_ns * HANG_FACTOR > HANG_MIN_NS ? budget_ns * HANG_FACTOR : HANG_MIN_NS;
-            if (now - t0 > hang)
-                return W_OVERRUN; /* blocked without using its CPU: the plan cannot wait */
+            if (now - t0 > hang) {
+                *cause = OV_WALL_LIMIT; /* blocked without using its CPU: the plan cannot wait */
+                return W_OVERRUN;
+            }
             wait_ns = budget_ns - used;
             if (wait_ns > 10000000)
                 wait_ns = 10000000;
@@ -733,7 +775,10 @@ static void transfer_queues(ske_t *s, part_t *p, int64_t t_ns)
                 atomic_store(&dd->rx_tail, atomic_load(&((ske_queue_hdr_t *)dq)->head));
                 dtail = atomic_load(&dd->rx_tail);
             }
-            if (ske_queue_push(dq, dc->max_size, dc->max_nb, dtail, buf, len, mt)) {
+            /* Stamped with its arrival, the end of the source's window: a receiver whose
+             * time-out comes later gets it, one whose time-out came first does not. */
+            (void)mt;
+            if (ske_queue_push(dq, dc->max_size, dc->max_nb, dtail, buf, len, t_ns)) {
                 s->chan_messages[pc->channel]++;
             } else {
                 atomic_fetch_add(&((ske_queue_hdr_t *)dq)->overflows, 1);
@@ -850,8 +895,10 @@ static int handle_mode_request(ske_t *s, part_t *p, int64_t t, char *err, size_t
         p->initial_mode = req;
         p->restarts++;
         p->state = PS_NOT_STARTED;
-        return spawn(s, p, err, errlen);
+        return respawn(s, p, t);
     }
+    (void)err;
+    (void)errlen;
     return SKE_OK;
 }
 
@@ -926,13 +973,30 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
     ske_trace_end(&s->trace);
 
     wres_t r = W_EXIT;
+    ov_cause_t cause = OV_CPU_BUDGET;
     bool granted = false;
+    int64_t outside_ns = 0; /* CPU the partition used since it last handed the CPU back */
     if (alive(p)) {
         granted = true;
         s->cur_partition = w->partition;
         int64_t cpu0 = cpu_now(p);
-        if (p->cpu_at_yield_ns >= 0 && cpu0 >= 0 && cpu0 - p->cpu_at_yield_ns > p->cpu_outside_max_ns)
-            p->cpu_outside_max_ns = cpu0 - p->cpu_at_yield_ns;
+        if (p->cpu_at_yield_ns >= 0 && cpu0 >= 0) {
+            outside_ns = cpu0 - p->cpu_at_yield_ns;
+            if (outside_ns > p->cpu_outside_max_ns)
+                p->cpu_outside_max_ns = outside_ns;
+        }
+        if (outside_ns > OUTSIDE_LIMIT_NS) {
+            /* It handed the CPU back but went on computing between its windows (the
+             * kernel's accounting says so): time taken from the other partitions. */
+            ske_trace_begin(&s->trace, start, "ske", "overrun");
+            ske_trace_str(&s->trace, "partition", p->cfg->name);
+            ske_trace_int(&s->trace, "window", w->id);
+            ske_trace_int(&s->trace, "frame", frame);
+            ske_trace_str(&s->trace, "cause", "outside_window");
+            ske_trace_str(&s->trace, "action", "reported");
+            ske_trace_end(&s->trace);
+            p->overruns++;
+        }
         if (p->state == PS_STOPPED) {
             kill(p->pid, SIGCONT);
             p->state = PS_RUNNING;
@@ -943,7 +1007,7 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
         atomic_store_explicit(&p->ctl->grant_seq, p->grant_seq, memory_order_release);
         ske_futex_wake(&p->ctl->grant_seq);
         p->windows++;
-        r = wait_yield(s, p, w->duration_ns, s->epoch_mono_ns + end, cpu0);
+        r = wait_yield(s, p, w->duration_ns, s->epoch_mono_ns + end, cpu0, &cause);
         int64_t cpu1 = cpu_now(p);
         if (r == W_OVERRUN) {
             /* No waiting for the stop to take effect: a process with SIGSTOP pending cannot
@@ -994,6 +1058,7 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
         ske_trace_int(&s->trace, "window", w->id);
         ske_trace_int(&s->trace, "frame", frame);
         ske_trace_int(&s->trace, "budget_ns", w->duration_ns);
+        ske_trace_str(&s->trace, "cause", ov_cause_names[cause]);
         ske_trace_str(&s->trace, "action", "stopped");
         ske_trace_end(&s->trace);
     }
@@ -1001,6 +1066,12 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
         transfer_queues(s, p, end);
     if (r == W_YIELD && alive(p))
         rc = hm_take_post(s, p, end, err, errlen);
+    if (rc == SKE_OK && outside_ns > OUTSIDE_LIMIT_NS && alive(p)) {
+        char msg[96];
+        int n = snprintf(msg, sizeof msg, "used CPU between its windows before window %d", w->id);
+        rc = hm_handle(s, p, end, HM_ERR_WINDOW_OVERRUN, partition_state(p), 0, NULL, msg,
+                       (size_t)n, false, err, errlen);
+    }
     if (rc == SKE_OK && r == W_OVERRUN && alive(p)) {
         char msg[80];
         int n = snprintf(msg, sizeof msg, "window %d kept past its end (budget %lld ns)", w->id,
@@ -1120,13 +1191,13 @@ static void trace_schedule(ske_t *s)
         trace_mode(s, &s->parts[i], 0, SKE_MODE_COLD_START, SKE_MODE_IDLE, "power-on");
 }
 
-static void write_stats(ske_t *s, double wall_s)
+static int write_stats(ske_t *s, double wall_s)
 {
     if (!s->opts.stats_path)
-        return;
+        return 0;
     FILE *f = fopen(s->opts.stats_path, "w");
     if (!f)
-        return;
+        return -errno;
     const ske_module_cfg_t *m = s->cfg;
     fputs("{\"module\":", f);
     ske_json_escape(f, m->module_name, strlen(m->module_name));
@@ -1188,7 +1259,10 @@ static void write_stats(ske_t *s, double wall_s)
                 (unsigned long long)s->chan_overflows[c]);
     }
     fputs("]}\n", f);
-    fclose(f);
+    int rc = ferror(f) ? -EIO : 0;
+    if (fclose(f) != 0 && rc == 0)
+        rc = -(errno ? errno : EIO);
+    return rc;
 }
 
 int ske_run(ske_t *s, char *err, size_t errlen)
@@ -1196,6 +1270,10 @@ int ske_run(ske_t *s, char *err, size_t errlen)
     const ske_module_cfg_t *m = s->cfg;
     int rc = SKE_OK;
     s->start_mono_ns = ske_mono_ns();
+    s->pid = getpid();
+    /* Partitions run as the same user: without this, /proc/<ske>/fd would hand them every
+     * other partition's memory. */
+    prctl(PR_SET_DUMPABLE, 0UL);
     if (s->time_mode == SKE_TIME_REALTIME)
         prctl(PR_SET_TIMERSLACK, 1UL); /* the default 50 µs slack would be window jitter */
     s->epoch_mono_ns = s->start_mono_ns; /* refined below for real-time mode */
@@ -1216,6 +1294,12 @@ int ske_run(ske_t *s, char *err, size_t errlen)
          ske_plan_next(m, &slot)) {
         if (s->stop_signal || s->hm_shutdown)
             break;
+        if (slot.index == 0 && slot.frame > INT64_MAX / m->major_frame_ns - 1) {
+            /* The next major frame would start past the end of the 64-bit nanosecond clock
+             * (about 292 years of module time). */
+            snprintf(s->exit_reason, sizeof s->exit_reason, "end_of_time");
+            break;
+        }
         if (slot.index == 0 && s->hm_reset) {
             rc = hm_module_reset(s, slot.start_ns, err, errlen);
             if (rc != SKE_OK)
@@ -1242,8 +1326,19 @@ done:
     ske_trace_int(&s->trace, "frames", s->frames_done);
     ske_trace_str(&s->trace, "reason", s->exit_reason);
     ske_trace_end(&s->trace);
-    ske_trace_close(&s->trace);
-    write_stats(s, (double)(ske_mono_ns() - s->start_mono_ns) / 1e9);
+    int trc = ske_trace_close(&s->trace);
+    int src = write_stats(s, (double)(ske_mono_ns() - s->start_mono_ns) / 1e9);
+    /* Recorded data that could not be written is a failed run, whatever else went right. */
+    if (trc != 0 && rc == SKE_OK) {
+        snprintf(err, errlen, "the trace %s could not be written: %s", s->opts.trace_path,
+                 strerror(-trc));
+        rc = SKE_E_IO;
+    }
+    if (src != 0 && rc == SKE_OK) {
+        snprintf(err, errlen, "the statistics %s could not be written: %s", s->opts.stats_path,
+                 strerror(-src));
+        rc = SKE_E_IO;
+    }
     return rc;
 }
 

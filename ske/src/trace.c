@@ -24,14 +24,17 @@ int ske_trace_open(ske_trace_t *t, const char *path, const char *node)
     return 0;
 }
 
-void ske_trace_close(ske_trace_t *t)
+int ske_trace_close(ske_trace_t *t)
 {
+    int rc = 0;
     if (t->f) {
-        fflush(t->f);
-        if (t->owned)
-            fclose(t->f);
+        if (fflush(t->f) != 0 || ferror(t->f))
+            rc = -(errno ? errno : EIO);
+        if (t->owned && fclose(t->f) != 0 && rc == 0)
+            rc = -(errno ? errno : EIO);
     }
     t->f = NULL;
+    return rc;
 }
 
 void ske_json_escape(FILE *f, const char *s, size_t len)

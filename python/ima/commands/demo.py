@@ -40,10 +40,7 @@ def run(args: argparse.Namespace) -> int:
     if not module.is_file():
         raise ImaError(f"example module not found: {module}")
     console = Console()
-    console.rule(
-        f"IMA Testbed demo: {module.relative_to(paths.repo_root())}, "
-        f"{args.frames} major frames, emulated time"
-    )
+    console.rule(f"IMA Testbed demo: {module.name}, {args.frames} major frames")
     with tempfile.TemporaryDirectory(prefix="ima-demo-") as tmp:
         trace = Path(tmp) / "trace.jsonl"
         try:
@@ -55,12 +52,12 @@ def run(args: argparse.Namespace) -> int:
         reports = last_reports(trace)
     if stats:
         ske.print_summary(stats, console)
+    elif returncode != ske.EXIT_CONFIG_ERROR:
+        raise ImaError(f"ima-ske wrote no statistics (exit code {returncode})")
     if reports:
         console.print("What the partitions last reported (REPORT_APPLICATION_MESSAGE):")
         for src, (t_ns, text) in reports.items():
             console.print(f"  {t_ns / 1e9:8.3f} s  {src:10} {text}", markup=False, highlight=False)
-    elif returncode != ske.EXIT_CONFIG_ERROR:
-        raise ImaError(f"ima-ske wrote no statistics (exit code {returncode})")
     return exit_code(returncode)
 
 

@@ -204,6 +204,8 @@ uint32_t ske_queue_count(const void *mem, uint32_t capacity, uint32_t tail);
 /* Producer side. Returns false when full. */
 bool ske_queue_push(void *mem, uint32_t max_size, uint32_t capacity, uint32_t tail,
                     const void *msg, uint32_t len, int64_t t_ns);
+/* The time stamped on the message at `tail` (a destination queue: its arrival). */
+int64_t ske_queue_head_time(const void *mem, uint32_t max_size, uint32_t capacity, uint32_t tail);
 /* Consumer side: copy the message at `tail` (the caller then advances its tail). */
 void ske_queue_peek(const void *mem, uint32_t max_size, uint32_t capacity, uint32_t tail,
                     void *msg, uint32_t *len, int64_t *t_ns);

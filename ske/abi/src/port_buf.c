@@ -73,15 +73,25 @@ void ske_sampling_write(void *mem, uint32_t max_size, const void *msg, uint32_t 
 bool ske_sampling_read(const void *mem, uint32_t max_size, void *msg, uint32_t *len, int64_t *t_ns)
 {
     const ske_sampling_hdr_t *h = mem;
-    uint32_t seq = atomic_load_explicit(&h->seq, memory_order_acquire);
-    if (seq == 0)
-        return false;
-    const ske_slot_hdr_t *s = slot_at((void *)mem, sizeof(*h), max_size, seq & 1u);
-    uint32_t n = s->len <= max_size ? s->len : max_size;
-    memcpy(msg, s + 1, n);
-    *len = n;
-    *t_ns = s->t_ns;
-    return true;
+    /* Partitions never run at the same time, but a writer stopped late after an overrun
+     * might still be writing: if a new message was published while we copied, copy again. */
+    for (int tries = 0;; tries++) {
+        uint32_t seq = atomic_load_explicit(&h->seq, memory_order_acquire);
+        if (seq == 0)
+            return false;
+        const ske_slot_hdr_t *s = slot_at((void *)mem, sizeof(*h), max_size, seq & 1u);
+        uint32_t n = *(const volatile uint32_t *)&s->len; /* read once */
+        if (n > max_size)
+            n = max_size;
+        int64_t t = *(const volatile int64_t *)&s->t_ns;
+        memcpy(msg, s + 1, n);
+        atomic_thread_fence(memory_order_acquire);
+        if (atomic_load_explicit(&h->seq, memory_order_relaxed) == seq || tries >= 3) {
+            *len = n;
+            *t_ns = t;
+            return true;
+        }
+    }
 }
 
 void ske_queue_init(void *mem, uint32_t max_size, uint32_t capacity)
@@ -123,10 +133,19 @@ void ske_queue_peek(const void *mem, uint32_t max_size, uint32_t capacity, uint3
 {
     const ske_slot_hdr_t *s = slot_at((void *)mem, sizeof(ske_queue_hdr_t), max_size,
                                       tail & (queue_slots(capacity) - 1u));
-    uint32_t n = s->len <= max_size ? s->len : max_size;
+    uint32_t n = *(const volatile uint32_t *)&s->len; /* read once: the bound is checked */
+    if (n > max_size)
+        n = max_size;
+    *t_ns = *(const volatile int64_t *)&s->t_ns;
     memcpy(msg, s + 1, n);
     *len = n;
-    *t_ns = s->t_ns;
+}
+
+int64_t ske_queue_head_time(const void *mem, uint32_t max_size, uint32_t capacity, uint32_t tail)
+{
+    const ske_slot_hdr_t *s = slot_at((void *)mem, sizeof(ske_queue_hdr_t), max_size,
+                                      tail & (queue_slots(capacity) - 1u));
+    return *(const volatile int64_t *)&s->t_ns;
 }
 
 int64_t ske_mono_ns(void)

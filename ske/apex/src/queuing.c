@@ -94,6 +94,11 @@ void apex__service_port_waiters(void)
             if (p->wait == WAIT_QRECV) {
                 if (apex__queue_count((int)k) == 0)
                     break;
+                const ske_port_desc_t *d = &c->ports[k];
+                int64_t arrived = ske_queue_head_time(qhdr((int)k), d->max_size, d->max_nb,
+                                                      atomic_load(&d->rx_tail));
+                if (arrived > p->wake_at)
+                    break; /* its time-out came first: it times out (release_due) */
                 p->wait_rc = receive_now((int)k, p->q_buf, p->q_len_out);
             } else {
                 if (!send_now((int)k, p->q_msg, p->q_len))

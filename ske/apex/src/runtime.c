@@ -280,8 +280,10 @@ static void __attribute__((noreturn)) scheduler_loop(void)
     apex_rt_t *rt = &apex__rt;
     for (;;) {
         apex__sync();
-        release_due();
+        /* Port waits first: a message that arrived (or a slot that freed) before a waiter's
+         * time-out wins over the time-out, even when both are past by now. */
         apex__service_port_waiters();
+        release_due();
         apex__hm_check_deadlines();
         apex_proc_t *p = pick();
         if (p) {

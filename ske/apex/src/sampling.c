@@ -101,7 +101,8 @@ void READ_SAMPLING_MESSAGE(
     }
     /* Valid when the message's age is within the refresh period (Part 1, 2.3.5.3). */
     int64_t age = apex__now() - t;
-    VALIDITY_TYPE v = age <= d->refresh_ns ? VALID : INVALID;
+    /* A stamp from the future is a corrupted one: never valid. */
+    VALIDITY_TYPE v = age >= 0 && age <= d->refresh_ns ? VALID : INVALID;
     if (!ap->validity_known || ap->last_validity != v)
         apex__event(SKE_EV_PORT_VALIDITY, k, v, NULL, 0);
     ap->validity_known = true;

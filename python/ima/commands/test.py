@@ -59,6 +59,17 @@ def summary(outcomes: Sequence[Outcome]) -> tuple[str, int]:
     return line, 0 if all(o.ok for o in outcomes) else 1
 
 
+# The unit tests, built a second time with AddressSanitizer and UndefinedBehaviorSanitizer.
+SANITIZED_TARGETS = ("test_config", "test_port_buf", "test_plan", "test_hm")
+
+
+def sanitizer_commands(root: Path, build: Path) -> list[list[str]]:
+    """Configure and build the sanitized unit tests in `build` (a tree of their own)."""
+    configure = ["cmake", "-S", str(root), "-B", str(build), "-G", "Ninja",
+                 "-DIMA_SANITIZE=ON", "-DCMAKE_BUILD_TYPE=Debug"]
+    return [configure, ["cmake", "--build", str(build), "--target", *SANITIZED_TARGETS]]
+
+
 def ctest_command(build: Path) -> list[str]:
     return ["ctest", "--test-dir", str(build), "--output-on-failure", "--no-tests=error", "-j2"]
 
@@ -91,6 +102,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     only = parser.add_mutually_exclusive_group()
     only.add_argument("--unit-only", action="store_true", help="run ctest only")
     only.add_argument("--py-only", action="store_true", help="run pytest only")
+    parser.add_argument(
+        "--no-sanitize",
+        action="store_true",
+        help="skip the unit tests under AddressSanitizer and UndefinedBehaviorSanitizer",
+    )
     return parser
 
 
@@ -106,6 +122,26 @@ def _run_ctest(root: Path, build: Path) -> Outcome:
     except FileNotFoundError:
         return Outcome("ctest", False, "ctest not found: install the Debian package cmake")
     return ctest_outcome(done.returncode)
+
+
+def _run_sanitized(root: Path, build: Path) -> Outcome:
+    """The unit tests again, built with ASan + UBSan in build-asan/: memory and undefined-
+    behaviour errors fail the run (-fno-sanitize-recover)."""
+    log = build / "ima-build.log"
+    build.mkdir(parents=True, exist_ok=True)
+    with log.open("w") as f:
+        for cmd in sanitizer_commands(root, build):
+            done = subprocess.run(cmd, cwd=root, stdout=f, stderr=subprocess.STDOUT)
+            if done.returncode != 0:
+                print(f"ima: the sanitizer build failed (log: {log})", file=sys.stderr)
+                print(log.read_text()[-3000:], file=sys.stderr)
+                return Outcome("ctest (ASan+UBSan)", False, "build failed")
+    cmd = ctest_command(build) + ["-R", "^(" + "|".join(SANITIZED_TARGETS) + ")$"]
+    env = dict(os.environ, ASAN_OPTIONS="detect_leaks=1:abort_on_error=1",
+               UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1")
+    done = subprocess.run(cmd, cwd=root, env=env)
+    outcome = ctest_outcome(done.returncode)
+    return Outcome("ctest (ASan+UBSan)", outcome.ok, outcome.reason)
 
 
 def _run_pytest(root: Path, keyword: str | None) -> Outcome:
@@ -124,6 +160,8 @@ def run(args: argparse.Namespace) -> int:
     outcomes = []
     if not args.py_only:
         outcomes.append(_run_ctest(root, paths.build_dir()))
+        if not args.no_sanitize:
+            outcomes.append(_run_sanitized(root, root / "build-asan"))
     if not args.unit_only:
         outcomes.append(_run_pytest(root, args.keyword))
     line, code = summary(outcomes)

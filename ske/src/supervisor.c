@@ -310,6 +310,12 @@ static void child_exec(ske_t *s, part_t *p, int errpipe, char **envp)
     /* Same addresses on every run: fault addresses in the trace (and anything a partition
      * derives from its own addresses) repeat, so emulated runs stay byte-identical. */
     personality(ADDR_NO_RANDOMIZE);
+    /* No capability survives the exec, even for uid 0: with an empty bounding set the
+     * program gains none (no CAP_SYS_PTRACE to open the SKE's descriptors, no CAP_SYS_ADMIN
+     * for /proc/self/map_files, no CAP_KILL, ...), and no_new_privs keeps it that way. */
+    for (int cap = 0; cap <= 63; cap++)
+        prctl(PR_CAPBSET_DROP, (unsigned long)cap, 0UL, 0UL, 0UL);
+    prctl(PR_SET_NO_NEW_PRIVS, 1UL, 0UL, 0UL, 0UL);
     struct sigaction dfl = {.sa_handler = SIG_DFL};
     sigaction(SIGINT, &dfl, NULL);
     sigaction(SIGTERM, &dfl, NULL);

@@ -136,7 +136,9 @@ int64_t apex__next_period_start(int64_t t);
 int apex__port_index(APEX_INTEGER id, uint32_t kind);
 /* Index of a configured port by APEX name (NAME_TYPE need not be NUL-terminated). */
 int apex__port_by_name(const char *name, uint32_t kind);
-/* Maps configured port k (read-only for destinations); false if it cannot be mapped. */
+/* Maps every port of the partition and closes their descriptors (at attach). */
+void apex__ports_attach(void);
+/* Marks configured port k created; false if it could not be mapped at attach. */
 bool apex__port_map(int k);
 /* Whether the current process may wait: not the initialisation process, not the error
  * handler, not while preemption is locked (ARINC 653 Part 1: blocking services return

@@ -3,6 +3,7 @@
  * only the descriptors the SKE gave it, destination ports read-only. */
 #include <string.h>
 #include <sys/mman.h>
+#include <unistd.h>
 
 #include "apex__rt.h"
 
@@ -29,15 +30,28 @@ int apex__port_index(APEX_INTEGER id, uint32_t kind)
     return k;
 }
 
+/* Maps every port the SKE gave the partition and closes the descriptors, before main()
+ * runs: the partition then holds no descriptor it could reopen with other rights
+ * (/proc/self/fd), and CREATE_*_PORT only checks the configuration. */
+void apex__ports_attach(void)
+{
+    ske_ctl_t *c = apex__rt.ctl;
+    for (uint32_t k = 0; k < c->n_ports && k < SKE_MAX_PORTS; k++) {
+        const ske_port_desc_t *d = &c->ports[k];
+        int prot = d->dir == SKE_DIR_SOURCE ? PROT_READ | PROT_WRITE : PROT_READ;
+        void *m = mmap(NULL, d->map_size, prot, MAP_SHARED, d->fd, 0);
+        if (m != MAP_FAILED) {
+            apex__rt.ports[k].mem = m;
+            apex__rt.ports[k].map_size = d->map_size;
+        }
+        close(d->fd);
+    }
+}
+
 bool apex__port_map(int k)
 {
-    const ske_port_desc_t *d = &apex__rt.ctl->ports[k];
-    int prot = d->dir == SKE_DIR_SOURCE ? PROT_READ | PROT_WRITE : PROT_READ;
-    void *m = mmap(NULL, d->map_size, prot, MAP_SHARED, d->fd, 0);
-    if (m == MAP_FAILED)
-        return false;
-    apex__rt.ports[k].mem = m;
-    apex__rt.ports[k].map_size = d->map_size;
+    if (!apex__rt.ports[k].mem)
+        return false; /* the SKE's descriptor could not be mapped */
     apex__rt.ports[k].created = true;
     return true;
 }

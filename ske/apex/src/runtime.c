@@ -93,6 +93,7 @@ __attribute__((constructor)) static void apex_attach(void)
         prctl(PR_SET_TIMERSLACK, 1UL); /* time-outs inside a window wake on time */
     rt->mode = (OPERATING_MODE_TYPE)rt->ctl->initial_mode;
     rt->seen_grant = 0;
+    apex__ports_attach();
     apex__hm_init();
     atomic_store(&rt->ctl->ready, 1);
     ske_futex_wake(&rt->ctl->ready);

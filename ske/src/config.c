@@ -541,6 +541,10 @@ static void load_partition(loader_t *L, const xmlNode *n)
     if (!attr(n, "Criticality", p->criticality, sizeof p->criticality))
         snprintf(p->criticality, sizeof p->criticality, "LEVEL_E");
     p->system_partition = attr_bool(n, "SystemPartition", false);
+    xmlChar *sch = xmlGetNsProp(n, (const xmlChar *)"ScheduleChange", (const xmlChar *)EXT_NS);
+    p->schedule_change = sch && (strcmp((const char *)sch, "true") == 0 || strcmp((const char *)sch, "1") == 0);
+    if (sch)
+        xmlFree(sch);
     attr(n, "EntryPoint", p->entry_point, sizeof p->entry_point);
     bool have_linux = false;
     for (const xmlNode *c = n->children; c; c = c->next) {
@@ -593,12 +597,48 @@ static void load_memory(loader_t *L, const xmlNode *n)
 static void load_schedule(loader_t *L, const xmlNode *n)
 {
     ske_module_cfg_t *m = L->m;
-    if (!attr_seconds(L, n, "MajorFrameSeconds", &m->major_frame_ns, true))
+    if (m->n_schedules >= SKE_MAX_SCHEDULES) {
+        fail(L, n, "at most 8 module schedules", "too many Module_Schedule elements");
         return;
-    if (m->major_frame_ns <= 0) {
+    }
+    int si = m->n_schedules;
+    ske_schedule_cfg_t *sc = &m->schedules[si];
+    memset(sc, 0, sizeof *sc);
+    sc->line = line_of(L, n);
+    uint64_t sid = (uint64_t)si + 1;
+    if (!attr_u64(L, n, "ScheduleIdentifier", &sid, INT32_MAX, false) && L->failed)
+        return;
+    sc->id = (int32_t)sid;
+    char name[256];
+    if (attr(n, "ScheduleName", name, sizeof name)) {
+        if (!attr_name(L, n, "ScheduleName", sc->name))
+            return;
+    } else {
+        snprintf(sc->name, sizeof sc->name, "SCHEDULE_%d", sc->id);
+    }
+    for (int i = 0; i < si; i++)
+        if (m->schedules[i].id == sc->id || strcmp(m->schedules[i].name, sc->name) == 0) {
+            fail(L, n, "module schedules have distinct identifiers and names",
+                 "ScheduleIdentifier=%d / ScheduleName='%s' is already used (line %d)", sc->id,
+                 sc->name, m->schedules[i].line);
+            return;
+        }
+    sc->initial = attr_bool(n, "InitialModuleSchedule", false);
+    int64_t maf;
+    if (!attr_seconds(L, n, "MajorFrameSeconds", &maf, true))
+        return;
+    if (maf <= 0) {
         fail(L, n, "the major frame is positive", "MajorFrameSeconds must be greater than 0");
         return;
     }
+    if (si > 0 && maf != m->major_frame_ns) {
+        fail(L, n, "module schedules share the major frame",
+             "schedule '%s' has a major frame of %lld ns, the first schedule %lld ns", sc->name,
+             (long long)maf, (long long)m->major_frame_ns);
+        return;
+    }
+    m->major_frame_ns = maf;
+    m->n_schedules++;
     bool scheduled[SKE_MAX_PARTITIONS] = {false};
     for (const xmlNode *ps = n->children; ps && !L->failed; ps = ps->next) {
         if (!is_elem(ps, "Partition_Schedule", false))
@@ -613,8 +653,16 @@ static void load_schedule(loader_t *L, const xmlNode *n)
             return;
         }
         scheduled[pi] = true;
-        if (!attr_seconds(L, ps, "PeriodSeconds", &p->period_ns, true))
+        int64_t period;
+        if (!attr_seconds(L, ps, "PeriodSeconds", &period, true))
             return;
+        if (p->period_ns && period != p->period_ns) {
+            fail(L, ps, "a partition has the same period in every module schedule",
+                 "partition '%s' has period %lld ns here but %lld ns in another schedule",
+                 p->name, (long long)period, (long long)p->period_ns);
+            return;
+        }
+        p->period_ns = period;
         if (p->period_ns <= 0 || m->major_frame_ns % p->period_ns != 0) {
             fail(L, ps, "the partition period divides the major frame",
                  "PeriodSeconds of partition '%s' (%lld ns) does not divide the major frame "
@@ -638,6 +686,7 @@ static void load_schedule(loader_t *L, const xmlNode *n)
             memset(win, 0, sizeof *win);
             win->line = line_of(L, w);
             win->partition = pi;
+            win->schedule = si;
             uint64_t wid;
             if (!attr_u64(L, w, "WindowIdentifier", &wid, INT32_MAX, true) ||
                 !attr_seconds(L, w, "WindowStartSeconds", &win->offset_ns, true) ||
@@ -645,7 +694,7 @@ static void load_schedule(loader_t *L, const xmlNode *n)
                 return;
             win->id = (int32_t)wid;
             for (int i = 0; i < m->n_windows; i++)
-                if (m->windows[i].id == win->id) {
+                if (m->windows[i].id == win->id && m->windows[i].schedule == si) {
                     fail(L, w, "window identifiers are unique",
                          "WindowIdentifier=%d is already used (line %d)", win->id,
                          m->windows[i].line);
@@ -668,23 +717,28 @@ static void load_schedule(loader_t *L, const xmlNode *n)
             }
             win->period_start = attr_bool(w, "PartitionPeriodStart", false);
             if (win->period_start && !anchor_set) {
-                p->period_anchor_ns = win->offset_ns % p->period_ns;
+                p->anchor_in[si] = win->offset_ns % p->period_ns;
                 anchor_set = true;
             }
             total += win->duration_ns;
             p->n_windows++;
+            p->windows_in[si]++;
             m->n_windows++;
         }
         if (!anchor_set) {
             /* No window is marked as a period start: the first one starts the period. */
             int64_t first = INT64_MAX;
             for (int i = 0; i < m->n_windows; i++)
-                if (m->windows[i].partition == pi && m->windows[i].offset_ns < first)
+                if (m->windows[i].partition == pi && m->windows[i].schedule == si &&
+                    m->windows[i].offset_ns < first)
                     first = m->windows[i].offset_ns;
-            p->period_anchor_ns = first == INT64_MAX ? 0 : first % p->period_ns;
+            p->anchor_in[si] = first == INT64_MAX ? 0 : first % p->period_ns;
         }
         int64_t periods = m->major_frame_ns / p->period_ns;
-        p->duration_ns = total / periods;
+        p->duration_in[si] = total / periods;
+        /* The initial schedule's are the partition's until the schedules are all read. */
+        p->duration_ns = p->duration_in[si];
+        p->period_anchor_ns = p->anchor_in[si];
         if (declared_duration >= 0 && declared_duration * periods != total) {
             fail(L, ps, "PeriodDurationSeconds is the window time per period",
                  "partition '%s' declares %lld ns per period but its windows give %lld ns per "
@@ -697,7 +751,7 @@ static void load_schedule(loader_t *L, const xmlNode *n)
             int64_t lo = p->period_anchor_ns + k * p->period_ns, hi = lo + p->period_ns, in = 0;
             for (int i = 0; i < m->n_windows; i++) {
                 const ske_window_cfg_t *win = &m->windows[i];
-                if (win->partition != pi)
+                if (win->partition != pi || win->schedule != si)
                     continue;
                 /* offsets before the anchor belong to the last period, wrapping the frame */
                 int64_t off = win->offset_ns < p->period_anchor_ns ? win->offset_ns + m->major_frame_ns
@@ -731,6 +785,8 @@ static void load_schedule(loader_t *L, const xmlNode *n)
 static int cmp_window(const void *a, const void *b)
 {
     const ske_window_cfg_t *x = a, *y = b;
+    if (x->schedule != y->schedule)
+        return (x->schedule > y->schedule) - (x->schedule < y->schedule);
     return (x->offset_ns > y->offset_ns) - (x->offset_ns < y->offset_ns);
 }
 
@@ -740,7 +796,7 @@ static void check_windows(loader_t *L, const xmlNode *root)
     qsort(m->windows, (size_t)m->n_windows, sizeof m->windows[0], cmp_window);
     for (int i = 1; i < m->n_windows; i++) {
         const ske_window_cfg_t *a = &m->windows[i - 1], *b = &m->windows[i];
-        if (b->offset_ns < a->offset_ns + a->duration_ns) {
+        if (a->schedule == b->schedule && b->offset_ns < a->offset_ns + a->duration_ns) {
             /* Report at the later window, naming the one it overlaps. */
             const ske_window_cfg_t *late = a->line > b->line ? a : b;
             const ske_window_cfg_t *early = late == a ? b : a;
@@ -767,6 +823,38 @@ static void check_windows(loader_t *L, const xmlNode *root)
             L->failed = true;
             return;
         }
+    }
+    /* Each schedule's windows, now grouped in schedule order; the initial schedule. */
+    int initial = -1;
+    for (int s = 0; s < m->n_schedules; s++) {
+        ske_schedule_cfg_t *sc = &m->schedules[s];
+        sc->first_window = -1;
+        for (int i = 0; i < m->n_windows; i++)
+            if (m->windows[i].schedule == s) {
+                if (sc->first_window < 0)
+                    sc->first_window = i;
+                sc->n_windows++;
+            }
+        if (sc->first_window < 0)
+            sc->first_window = 0;
+        if (sc->initial) {
+            if (initial >= 0) {
+                L->failed = false;
+                diag_set(L->diag, m->path, sc->line, "Module_Schedule",
+                         "one initial module schedule",
+                         "schedules '%s' and '%s' are both InitialModuleSchedule",
+                         m->schedules[initial].name, sc->name);
+                L->failed = true;
+                return;
+            }
+            initial = s;
+        }
+    }
+    m->initial_schedule = initial >= 0 ? initial : 0;
+    for (int i = 0; i < m->n_partitions; i++) {
+        ske_partition_cfg_t *p = &m->partitions[i];
+        p->duration_ns = p->duration_in[m->initial_schedule];
+        p->period_anchor_ns = p->anchor_in[m->initial_schedule];
     }
     (void)root;
 }

@@ -94,6 +94,8 @@ struct ske {
     int64_t prev_yield_mono_ns; /* the previous window's yield, for the switch figure */
     uint8_t *xfer; /* one message, for queue transfers */
     pid_t pid; /* the SKE's own process, for its partitions to check */
+    int next_schedule; /* schedule index to run from the next major frame */
+    int64_t last_switch_ns;
     bool hm_shutdown; /* a module-level SHUTDOWN: the run ends */
     bool hm_reset; /* a module-level RESET: every partition restarts at the next frame */
     uint64_t hm_events;
@@ -278,6 +280,20 @@ static void fill_ctl(ske_t *s, part_t *p)
     _Static_assert(SKE_HM_STATES == HM_STATE_COUNT && SKE_HM_ERRORS == HM_ERR_COUNT,
                    "the control block's HM table has the health monitor's shape");
     memcpy(c->hm_level, s->cfg->hm.level, sizeof c->hm_level);
+    const ske_module_cfg_t *m = s->cfg;
+    c->n_schedules = (uint32_t)m->n_schedules;
+    c->schedule_change_allowed = p->cfg->schedule_change;
+    for (int i = 0; i < m->n_schedules && i < SKE_SCHEDULES; i++) {
+        c->schedule_ids[i] = m->schedules[i].id;
+        snprintf(c->schedule_names[i], SKE_NAME_MAX, "%s", m->schedules[i].name);
+    }
+    int cur = s->next_schedule;
+    int32_t cur_id = m->n_schedules ? m->schedules[cur].id : 1;
+    atomic_store(&c->current_schedule, cur_id);
+    atomic_store(&c->next_schedule, cur_id);
+    atomic_store(&c->last_switch_ns, s->last_switch_ns);
+    c->duration_ns = p->cfg->duration_in[cur];
+    c->period_anchor_ns = p->cfg->anchor_in[cur];
     p->grant_seq = 0;
     p->mode_request_seq = 0;
 }
@@ -908,6 +924,59 @@ static int handle_mode_request(ske_t *s, part_t *p, int64_t t, char *err, size_t
     return SKE_OK;
 }
 
+/* A partition asked for another module schedule (SET_MODULE_SCHEDULE): checked again here,
+ * it takes effect at the next major frame (ARINC 653 Part 2, 3.2). */
+static void take_schedule_request(ske_t *s, part_t *p, int64_t t)
+{
+    ske_ctl_t *c = p->ctl;
+    uint32_t seq = atomic_load(&c->schedule_request_seq);
+    if (seq == atomic_load(&c->schedule_request_ack))
+        return;
+    atomic_store(&c->schedule_request_ack, seq);
+    int32_t id = atomic_load(&c->schedule_request);
+    const ske_module_cfg_t *m = s->cfg;
+    int to = -1;
+    for (int i = 0; i < m->n_schedules; i++)
+        if (m->schedules[i].id == id)
+            to = i;
+    if (to < 0 || !p->cfg->schedule_change)
+        return; /* the partition's APEX already refused it */
+    s->next_schedule = to;
+    ske_trace_begin(&s->trace, t, "ske", "schedule_request");
+    ske_trace_str(&s->trace, "partition", p->cfg->name);
+    ske_trace_int(&s->trace, "schedule", id);
+    ske_trace_str(&s->trace, "name", m->schedules[to].name);
+    ske_trace_end(&s->trace);
+    for (int i = 0; i < m->n_partitions; i++)
+        if (s->parts[i].ctl)
+            atomic_store(&s->parts[i].ctl->next_schedule, id);
+}
+
+/* Runs schedule `to` from the frame starting at t: every partition's control block follows. */
+static void switch_schedule(ske_t *s, ske_slot_t *slot, int to)
+{
+    const ske_module_cfg_t *m = s->cfg;
+    int from = slot->schedule;
+    ske_plan_switch(m, slot, to);
+    s->last_switch_ns = slot->frame * m->major_frame_ns;
+    ske_trace_begin(&s->trace, s->last_switch_ns, "ske", "schedule_switch");
+    ske_trace_int(&s->trace, "from", m->schedules[from].id);
+    ske_trace_int(&s->trace, "to", m->schedules[to].id);
+    ske_trace_str(&s->trace, "name", m->schedules[to].name);
+    ske_trace_int(&s->trace, "frame", slot->frame);
+    ske_trace_end(&s->trace);
+    for (int i = 0; i < m->n_partitions; i++) {
+        ske_ctl_t *c = s->parts[i].ctl;
+        if (!c)
+            continue;
+        atomic_store(&c->current_schedule, m->schedules[to].id);
+        atomic_store(&c->next_schedule, m->schedules[to].id);
+        atomic_store(&c->last_switch_ns, s->last_switch_ns);
+        c->duration_ns = m->partitions[i].duration_in[to];
+        c->period_anchor_ns = m->partitions[i].anchor_in[to];
+    }
+}
+
 /* A partition whose process ended without being asked to: PARTITION_EXIT. */
 static int judge_exits(ske_t *s, int64_t t, char *err, size_t errlen)
 {
@@ -1072,6 +1141,8 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
         transfer_queues(s, p, end);
     if (r == W_YIELD && alive(p))
         rc = hm_take_post(s, p, end, err, errlen);
+    if (rc == SKE_OK && r == W_YIELD && alive(p))
+        take_schedule_request(s, p, end);
     if (rc == SKE_OK && outside_ns > OUTSIDE_LIMIT_NS && alive(p)) {
         char msg[96];
         int n = snprintf(msg, sizeof msg, "used CPU between its windows before window %d", w->id);
@@ -1123,6 +1194,7 @@ int ske_create(const ske_module_cfg_t *cfg, const ske_run_opts_t *opts, ske_t **
     s->cfg = cfg;
     s->opts = *opts;
     s->cur_partition = -1;
+    s->next_schedule = cfg->n_schedules ? cfg->initial_schedule : 0;
     s->time_mode = opts->time_mode >= 0 ? (ske_time_mode_t)opts->time_mode : cfg->time_mode;
     snprintf(s->node, sizeof s->node, "%s", opts->node ? opts->node : cfg->node);
     s->xfer = malloc(SYSTEM_MESSAGE_MAX);
@@ -1187,10 +1259,15 @@ static void trace_schedule(ske_t *s)
             fprintf(s->trace.f, "%s{\"window\":%d,\"partition\":", i ? "," : "", w->id);
             ske_json_escape(s->trace.f, m->partitions[w->partition].name,
                             strlen(m->partitions[w->partition].name));
-            fprintf(s->trace.f, ",\"offset_ns\":%" PRId64 ",\"duration_ns\":%" PRId64 "}",
-                    w->offset_ns, w->duration_ns);
+            fprintf(s->trace.f, ",\"offset_ns\":%" PRId64 ",\"duration_ns\":%" PRId64, w->offset_ns,
+                    w->duration_ns);
+            if (m->n_schedules > 1)
+                fprintf(s->trace.f, ",\"schedule\":%d", m->schedules[w->schedule].id);
+            fputc('}', s->trace.f);
         }
         fputc(']', s->trace.f);
+        if (m->n_schedules > 1)
+            fprintf(s->trace.f, ",\"initial_schedule\":%d", m->schedules[m->initial_schedule].id);
     }
     ske_trace_end(&s->trace);
     for (int i = 0; i < m->n_partitions; i++)
@@ -1243,8 +1320,11 @@ static int write_stats(ske_t *s, double wall_s)
         const ske_window_cfg_t *w = &m->windows[i];
         fprintf(f, "%s{\"window\":%d,\"partition\":", i ? "," : "", w->id);
         ske_json_escape(f, m->partitions[w->partition].name, strlen(m->partitions[w->partition].name));
-        fprintf(f, ",\"offset_ns\":%" PRId64 ",\"duration_ns\":%" PRId64 "}", w->offset_ns,
+        fprintf(f, ",\"offset_ns\":%" PRId64 ",\"duration_ns\":%" PRId64, w->offset_ns,
                 w->duration_ns);
+        if (m->n_schedules > 1)
+            fprintf(f, ",\"schedule\":%d", m->schedules[w->schedule].id);
+        fputc('}', f);
     }
     fputs("],\"window_switch_us\":", f);
     ske_samples_json_us(&s->switch_ns, f);
@@ -1306,6 +1386,8 @@ int ske_run(ske_t *s, char *err, size_t errlen)
             snprintf(s->exit_reason, sizeof s->exit_reason, "end_of_time");
             break;
         }
+        if (slot.index == 0 && m->n_schedules && s->next_schedule != slot.schedule)
+            switch_schedule(s, &slot, s->next_schedule);
         if (slot.index == 0 && s->hm_reset) {
             rc = hm_module_reset(s, slot.start_ns, err, errlen);
             if (rc != SKE_OK)

@@ -19,6 +19,7 @@
 #define SKE_EVENT_TEXT 128
 #define SKE_HM_STATES 4 /* hm_state_t values */
 #define SKE_HM_ERRORS 11 /* hm_error_t values, 0 unused */
+#define SKE_SCHEDULES 8 /* module schedules (ARINC 653 Part 2) */
 
 /* Environment variable naming the control block's file descriptor in a partition. */
 #define SKE_ENV_CTL_FD "IMA_SKE_CTL_FD"
@@ -146,6 +147,19 @@ typedef struct {
     char hm_process_name[SKE_NAME_MAX];
     char hm_message[SKE_EVENT_TEXT];
     int64_t hm_t_ns;
+
+    /* Module schedules (ARINC 653 Part 2). The SKE writes the list and the status; a
+     * partition allowed to may ask for a switch, which takes effect at the next major frame. */
+    uint32_t n_schedules;
+    uint32_t schedule_change_allowed;
+    int32_t schedule_ids[SKE_SCHEDULES];
+    char schedule_names[SKE_SCHEDULES][SKE_NAME_MAX];
+    _Atomic int32_t current_schedule; /* identifier */
+    _Atomic int32_t next_schedule; /* identifier */
+    _Atomic int64_t last_switch_ns;
+    _Atomic int32_t schedule_request; /* identifier asked for (partition) */
+    _Atomic uint32_t schedule_request_seq; /* partition: incremented per request */
+    _Atomic uint32_t schedule_request_ack; /* SKE: the request it has taken */
     uint32_t pad1;
     ske_event_t ev[SKE_EVENT_RING];
 } ske_ctl_t;

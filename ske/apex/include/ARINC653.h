@@ -14,5 +14,6 @@
 #include "apex_semaphore.h"
 #include "apex_event.h"
 #include "apex_error.h"
+#include "apex_schedule.h"
 
 #endif /* ARINC653_H */

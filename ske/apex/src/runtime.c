@@ -183,6 +183,10 @@ void apex__make_ready(apex_proc_t *p)
 static apex_proc_t *pick(void)
 {
     apex_rt_t *rt = &apex__rt;
+    if (rt->lock_owner && rt->lock_owner->state == DORMANT) {
+        rt->lock_level = 0; /* its holder was stopped by a fault: the lock went with it */
+        rt->lock_owner = NULL;
+    }
     if (rt->has_eh && rt->eh.state == READY)
         return &rt->eh;
     if (rt->lock_level > 0 && rt->lock_owner && rt->lock_owner->state == READY)

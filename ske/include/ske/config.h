@@ -12,6 +12,7 @@
 
 #define SKE_MAX_PARTITIONS 32
 #define SKE_MAX_WINDOWS 256
+#define SKE_MAX_SCHEDULES 8
 #define SKE_MAX_CHANNELS 256
 #define SKE_MAX_DESTINATIONS 16
 #define SKE_MAX_ARGS 32
@@ -65,11 +66,16 @@ typedef struct {
     char exe_name[SKE_PATH_MAX]; /* as written in the module */
     int argc;
     char *argv[SKE_MAX_ARGS]; /* argv[0] is the partition name */
-    /* schedule */
+    /* schedule: period_ns is the same in every module schedule; duration and anchor are the
+     * initial schedule's, with each schedule's own in the _in arrays */
     int64_t period_ns;
     int64_t duration_ns; /* window time per period */
     int64_t period_anchor_ns;
-    int n_windows;
+    int n_windows; /* in all schedules */
+    int64_t duration_in[SKE_MAX_SCHEDULES];
+    int64_t anchor_in[SKE_MAX_SCHEDULES];
+    int windows_in[SKE_MAX_SCHEDULES];
+    bool schedule_change; /* may call SET_MODULE_SCHEDULE (ima:ScheduleChange) */
     /* memory */
     uint64_t memory_bytes; /* sum of Memory_Requirements, 0 if none declared */
     int n_ports;
@@ -82,6 +88,7 @@ typedef struct {
 
 typedef struct {
     int32_t id;
+    int schedule; /* index into module schedules */
     int partition; /* index into module partitions */
     int64_t offset_ns;
     int64_t duration_ns;
@@ -104,15 +111,28 @@ typedef struct {
     int line;
 } ske_channel_cfg_t;
 
+/* A module schedule (ARINC 653 Part 2 allows several; the initial one runs first). */
+typedef struct {
+    int32_t id;
+    char name[SKE_NAME_MAX];
+    int first_window; /* its windows: m->windows[first_window .. first_window + n_windows) */
+    int n_windows;
+    bool initial;
+    int line;
+} ske_schedule_cfg_t;
+
 typedef struct {
     char path[SKE_PATH_MAX];
     char module_name[64];
     char node[SKE_NAME_MAX];
     ske_time_mode_t time_mode;
-    int64_t major_frame_ns;
+    int64_t major_frame_ns; /* the same in every module schedule */
+    int n_schedules; /* 0 only for a module built by hand: then the windows are one schedule */
+    ske_schedule_cfg_t schedules[SKE_MAX_SCHEDULES];
+    int initial_schedule;
     int n_partitions;
     ske_partition_cfg_t partitions[SKE_MAX_PARTITIONS];
-    int n_windows; /* sorted by offset */
+    int n_windows; /* grouped by schedule, sorted by offset within each */
     ske_window_cfg_t windows[SKE_MAX_WINDOWS];
     int n_channels;
     ske_channel_cfg_t channels[SKE_MAX_CHANNELS];

@@ -71,7 +71,8 @@ void CREATE_BUFFER(
     }
     /* At most 2^20 messages of 2^20 bytes: the product fits in 64 bits. */
     size_t n = (size_t)MAX_NB_MESSAGE;
-    APEX_BYTE *mem = apex__intra_alloc(n * (size_t)MAX_MESSAGE_SIZE + n * sizeof(MESSAGE_SIZE_TYPE));
+    APEX_BYTE *mem =
+        apex__intra_alloc(n * (size_t)MAX_MESSAGE_SIZE + n * sizeof(MESSAGE_SIZE_TYPE));
     if (!mem) {
         *RETURN_CODE = INVALID_CONFIG; /* insufficient storage */
         return;

@@ -9,7 +9,10 @@
 
 apex_intra_t apex__intra;
 
-bool apex__name_valid(const char *name) { return name && strnlen(name, MAX_NAME_LENGTH) > 0; }
+bool apex__name_valid(const char *name)
+{
+    return name && strnlen(name, MAX_NAME_LENGTH) > 0;
+}
 
 bool apex__name_equal(const char *a, const char *b)
 {

@@ -5,8 +5,7 @@
  * first 10 ms of it. */
 #include "apex_check.h"
 
-static PROCESS_ID_TYPE ctl_id, ready_id, delay_id, sem_id, cyclic_id, susp_id, never_id,
-    pending_id;
+static PROCESS_ID_TYPE ctl_id, ready_id, delay_id, sem_id, cyclic_id, susp_id, never_id, pending_id;
 static SEMAPHORE_ID_TYPE sem;
 static int delay_woke, sem_got, cyclic_runs, susp_runs, pending_ran;
 

@@ -10,8 +10,8 @@
 static PROCESS_ID_TYPE self_id;
 static int waiting_seen;
 
-static void try_suspend_self(const char *check, SYSTEM_TIME_TYPE time_out,
-                             RETURN_CODE_TYPE expect, SYSTEM_TIME_TYPE elapsed)
+static void try_suspend_self(const char *check, SYSTEM_TIME_TYPE time_out, RETURN_CODE_TYPE expect,
+                             SYSTEM_TIME_TYPE elapsed)
 {
     RETURN_CODE_TYPE rc;
     SYSTEM_TIME_TYPE t0 = now_ns();

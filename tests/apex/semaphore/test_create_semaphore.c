@@ -43,8 +43,8 @@ static void create(void)
     try_create("init.created", "S1", 0, 1, FIFO, NO_ERROR);
     try_create("init.same_name", "S1", 1, 2, PRIORITY, NO_ACTION);
     try_create("init.current_negative", "S2", -1, 1, FIFO, INVALID_PARAM);
-    try_create("init.current_over_limit", "S2", MAX_SEMAPHORE_VALUE + 1, MAX_SEMAPHORE_VALUE,
-               FIFO, INVALID_PARAM);
+    try_create("init.current_over_limit", "S2", MAX_SEMAPHORE_VALUE + 1, MAX_SEMAPHORE_VALUE, FIFO,
+               INVALID_PARAM);
     try_create("init.maximum_negative", "S2", 0, -1, FIFO, INVALID_PARAM);
     try_create("init.maximum_over_limit", "S2", 0, MAX_SEMAPHORE_VALUE + 1, FIFO, INVALID_PARAM);
     try_create("init.current_above_maximum", "S2", 3, 2, FIFO, INVALID_PARAM);

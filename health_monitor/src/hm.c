@@ -23,7 +23,9 @@ void hm_partition_defaults(hm_partition_table_t *t)
 {
     for (int s = 0; s < HM_STATE_COUNT; s++)
         for (int e = 0; e < HM_ERR_COUNT; e++)
-            t->action[s][e] = e == HM_ERR_WINDOW_OVERRUN ? HM_ACT_IGNORE : HM_ACT_IDLE;
+            t->action[s][e] = e == HM_ERR_WINDOW_OVERRUN || e == HM_ERR_DEADLINE_MISSED
+                                  ? HM_ACT_IGNORE
+                                  : HM_ACT_IDLE;
 }
 
 hm_level_t hm_level_of(const hm_system_table_t *t, hm_state_t state, hm_error_t err)

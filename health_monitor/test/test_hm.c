@@ -25,7 +25,9 @@ static void test_defaults(void)
         for (int e = 1; e < HM_ERR_COUNT; e++) {
             CHECK(hm_level_of(&sys, (hm_state_t)s, (hm_error_t)e) == HM_LEVEL_PARTITION);
             CHECK(hm_module_action(&sys, (hm_state_t)s, (hm_error_t)e) == HM_ACT_IGNORE);
-            hm_action_t want = e == HM_ERR_WINDOW_OVERRUN ? HM_ACT_IGNORE : HM_ACT_IDLE;
+            hm_action_t want = e == HM_ERR_WINDOW_OVERRUN || e == HM_ERR_DEADLINE_MISSED
+                                   ? HM_ACT_IGNORE
+                                   : HM_ACT_IDLE;
             CHECK(hm_partition_action(&part, (hm_state_t)s, (hm_error_t)e) == want);
         }
 }
@@ -55,7 +57,9 @@ static void test_lookup_is_per_cell(void)
                         hm_action_t m = hm_module_action(&sys, (hm_state_t)s2, (hm_error_t)e2);
                         CHECK(m == (here ? mod_actions[k] : HM_ACT_IGNORE));
                         hm_action_t a = hm_partition_action(&part, (hm_state_t)s2, (hm_error_t)e2);
-                        hm_action_t dflt = e2 == HM_ERR_WINDOW_OVERRUN ? HM_ACT_IGNORE : HM_ACT_IDLE;
+                        hm_action_t dflt = e2 == HM_ERR_WINDOW_OVERRUN || e2 == HM_ERR_DEADLINE_MISSED
+                                               ? HM_ACT_IGNORE
+                                               : HM_ACT_IDLE;
                         CHECK(a == (here ? part_actions[k + 1] : dflt));
                     }
             }

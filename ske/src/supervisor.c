@@ -15,10 +15,12 @@
 #include <sys/mman.h>
 #include <sys/personality.h>
 #include <sys/prctl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "ske__sandbox.h"
 #include "ske__stats.h"
 #include "ske__trace.h"
 
@@ -151,8 +153,12 @@ static int memobj(const char *name, size_t size, void **mem)
         return -errno;
     /* Sealed at its size: a partition holding a descriptor cannot shrink it under the SKE's
      * mapping (the SKE would die of SIGBUS on its next access). */
+    /* Read-only for its owner: a descriptor handed out read-write stays so, but nobody
+     * without capabilities (every partition) can open it anew for writing, e.g. a read-only
+     * destination descriptor through /proc/self/fd before the APEX library closes it. */
     if (ftruncate(fd, (off_t)size) != 0 ||
-        fcntl(fd, F_ADD_SEALS, F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_SEAL) != 0) {
+        fcntl(fd, F_ADD_SEALS, F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_SEAL) != 0 ||
+        fchmod(fd, 0400) != 0) {
         int e = errno;
         close(fd);
         return -e;
@@ -245,6 +251,7 @@ static void fill_ctl(ske_t *s, part_t *p)
     snprintf(c->node, sizeof c->node, "%s", s->node);
     c->time_mode = s->time_mode;
     c->system_partition = p->cfg->system_partition;
+    c->sandbox_flags = ske__sandbox_flags(p->cfg);
     c->epoch_mono_ns = s->epoch_mono_ns;
     c->period_ns = p->cfg->period_ns;
     c->duration_ns = p->cfg->duration_ns;
@@ -365,6 +372,14 @@ static void child_exec(ske_t *s, part_t *p, int errpipe, char **envp)
     close_range(5 + (unsigned)n, ~0U, 0);
     if (getppid() != s->pid)
         _exit(127); /* the SKE is already gone */
+    /* Last before the exec: the memory limit and the loader's system-call filter. A failure
+     * goes to the SKE as a negative number, told apart from an exec error. */
+    int confined = ske__sandbox_enter(p->cfg, 3, n);
+    if (confined != 0) {
+        ssize_t wc = write(4 + n, &confined, sizeof confined);
+        (void)wc;
+        _exit(127);
+    }
     execve(p->cfg->executable, p->cfg->argv, envp);
     int e = errno;
     ssize_t w = write(4 + n, &e, sizeof e);
@@ -419,9 +434,13 @@ static int spawn(ske_t *s, part_t *p, char *err, size_t errlen)
     } while (r < 0 && errno == EINTR);
     close(pipefd[0]);
     if (r == (ssize_t)sizeof e) {
-        waitpid(pid, NULL, 0);
-        snprintf(err, errlen, "cannot start partition '%s': %s: %s", p->cfg->name,
-                 p->cfg->executable, strerror(e));
+        waitpid(pid, NULL, 0); /* reaped: its pid may be anybody's from now on */
+        if (e < 0)
+            snprintf(err, errlen, "cannot start partition '%s': cannot confine its process "
+                     "(memory limit or system-call filter): %s", p->cfg->name, strerror(-e));
+        else
+            snprintf(err, errlen, "cannot start partition '%s': %s: %s", p->cfg->name,
+                     p->cfg->executable, strerror(e));
         return SKE_E_PARTITION;
     }
     p->pid = pid;
@@ -436,6 +455,7 @@ static int spawn(ske_t *s, part_t *p, char *err, size_t errlen)
         int st;
         pid_t w = waitpid(pid, &st, WNOHANG);
         if (w == pid) {
+            p->pid = 0; /* reaped: never signal that pid again */
             p->state = WIFSIGNALED(st) ? PS_CRASHED : PS_EXITED;
             p->exit_code = WIFSIGNALED(st) ? WTERMSIG(st) : WEXITSTATUS(st);
             snprintf(err, errlen, "partition '%s' (%s) %s before attaching to the SKE (%s %d)",
@@ -445,8 +465,10 @@ static int spawn(ske_t *s, part_t *p, char *err, size_t errlen)
             return SKE_E_PARTITION;
         }
         if (ske_mono_ns() - t0 > READY_TIMEOUT_NS) {
+            kill(-pid, SIGKILL);
             kill(pid, SIGKILL);
             waitpid(pid, NULL, 0);
+            p->pid = 0;
             p->state = PS_CRASHED;
             snprintf(err, errlen, "partition '%s' did not attach within 10 s (is it linked "
                      "with the APEX library?)", p->cfg->name);
@@ -458,6 +480,15 @@ static int spawn(ske_t *s, part_t *p, char *err, size_t errlen)
         }
         struct timespec ts = {0, 1000000};
         ske_futex_wait(&p->ctl->ready, 0, &ts);
+    }
+    /* Attached: its own filter is in place if it ever will be. A partition that is not
+     * confined never gets the CPU. */
+    if (ske__sandbox_verify(pid, p->cfg, err, errlen) != SKE_OK) {
+        kill(pid, SIGKILL);
+        waitpid(pid, NULL, 0);
+        p->pid = 0;
+        p->state = PS_NOT_STARTED;
+        return SKE_E_PARTITION;
     }
     return SKE_OK;
 }
@@ -623,8 +654,14 @@ static int hm_handle(ske_t *s, part_t *p, int64_t t, hm_error_t e, hm_state_t st
             s->hm_shutdown = true;
         else if (a == HM_ACT_RESET)
             s->hm_reset = true;
-        else if (fatal)
+        else if (fatal) {
+            ske_trace_begin(&s->trace, t, "ske", "hm_note");
+            ske_trace_str(&s->trace, "partition", p->cfg->name);
+            ske_trace_str(&s->trace, "note", "module IGNORE, but the failed initialisation cannot go "
+                                             "on: the partition is idled");
+            ske_trace_end(&s->trace);
             return apply_partition_action(s, p, HM_ACT_IDLE, t, err, errlen);
+        }
         return SKE_OK;
     }
     hm_action_t a = hm_partition_action(&p->cfg->hm, state, e);
@@ -656,7 +693,9 @@ static int hm_take_post(ske_t *s, part_t *p, int64_t t, char *err, size_t errlen
     atomic_store(&c->hm_ack, seq); /* the partition goes on once the action is decided */
     if (!hm_error_name(e) || !hm_state_name(st) || e == HM_ERR_WINDOW_OVERRUN || e == HM_ERR_PARTITION_EXIT)
         return SKE_OK; /* not an error a partition can report */
-    return hm_handle(s, p, t, e, st, process, process > 0 ? pname : NULL, msg, mlen, fatal, err, errlen);
+    /* The failed process's name; none for the initialisation process (the error handler,
+     * whose identifier is 0 too, has one). */
+    return hm_handle(s, p, t, e, st, process, pname[0] ? pname : NULL, msg, mlen, fatal, err, errlen);
 }
 
 /* Applies a pending module RESET: every partition starts again (ARINC 653 Part 1, 2.4.2). */
@@ -1083,6 +1122,25 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
         ske_futex_wake(&p->ctl->grant_seq);
         p->windows++;
         r = wait_yield(s, p, w->duration_ns, s->epoch_mono_ns + end, cpu0, &cause);
+        /* A partition that posted an error waits for the decision: take it now and, if the
+         * partition goes on (IGNORE), give it the rest of its window, still on the same
+         * CPU budget. What it reported before the error comes first in the trace. */
+        while (r == W_YIELD && alive(p) && atomic_load(&p->ctl->hm_seq) != atomic_load(&p->ctl->hm_ack)) {
+            drain_events(s, p, start, end);
+            int64_t at = p->ctl->hm_t_ns;
+            at = at < start ? start : at > end ? end : at;
+            pid_t before = p->pid;
+            int hrc = hm_take_post(s, p, at, err, errlen);
+            if (hrc != SKE_OK)
+                return hrc;
+            /* Idled, shut down, or restarted (a new process starts in its next window). */
+            if (!alive(p) || s->hm_shutdown || p->pid != before)
+                break;
+            p->grant_seq++;
+            atomic_store_explicit(&p->ctl->grant_seq, p->grant_seq, memory_order_release);
+            ske_futex_wake(&p->ctl->grant_seq);
+            r = wait_yield(s, p, w->duration_ns, s->epoch_mono_ns + end, cpu0, &cause);
+        }
         int64_t cpu1 = cpu_now(p);
         if (r == W_OVERRUN) {
             /* No waiting for the stop to take effect: a process with SIGSTOP pending cannot
@@ -1410,7 +1468,11 @@ int ske_run(ske_t *s, char *err, size_t errlen)
 done:
     for (int i = 0; i < m->n_partitions; i++)
         kill_partition(&s->parts[i]);
-    ske_trace_begin(&s->trace, s->frames_done * m->major_frame_ns, "ske", "module_stop");
+    /* A shutdown mid-frame stops at the end of the window where it was decided. */
+    int64_t stop_t = s->frames_done * m->major_frame_ns;
+    if (s->hm_shutdown && s->win_end_ns > stop_t)
+        stop_t = s->win_end_ns;
+    ske_trace_begin(&s->trace, stop_t, "ske", "module_stop");
     ske_trace_int(&s->trace, "frames", s->frames_done);
     ske_trace_str(&s->trace, "reason", s->exit_reason);
     ske_trace_end(&s->trace);

@@ -518,3 +518,105 @@ def test_ima_run_refuses_overlapping_windows(example, tmp_path):
         rule="windows of a module schedule do not overlap",
         says=("window 2 of partition 'consumer'", "overlaps window 1"),
     )
+
+
+# ---- partition periods within a longer major frame -----------------------------------------------
+
+
+def two_periods_per_frame(example: Module) -> Module:
+    """The example with a 100 ms major frame: the producer and the consumer keep one period
+    per frame (100 ms), the monitor keeps its 50 ms period, so it has two per frame."""
+    return (
+        example.replace('MajorFrameSeconds="0.05"', 'MajorFrameSeconds="0.1"')
+        .replace(
+            'PartitionName="producer" PeriodSeconds="0.05"',
+            'PartitionName="producer" PeriodSeconds="0.1"',
+        )
+        .replace(
+            'PartitionName="consumer" PeriodSeconds="0.05"',
+            'PartitionName="consumer" PeriodSeconds="0.1"',
+        )
+    )
+
+
+def test_partition_period_without_window_time(check, example):
+    # The monitor's one 8 ms window lies in the first of its two periods: 4 ms per period on
+    # average, but 8 ms in one and none in the other (ARINC 653 Part 1, 2.3.1.3).
+    bad = two_periods_per_frame(example).replace(
+        'PeriodDurationSeconds="0.008"', 'PeriodDurationSeconds="0.004"'
+    )
+    refused(
+        check,
+        bad,
+        at=bad.tag('<Partition_Schedule PartitionIdentifier="3"'),
+        element="Partition_Schedule",
+        rule="every partition period gets the same window time",
+        says=(
+            "partition 'monitor' gets",
+            "4000000 ns per period on average",
+            "(period 50000000 ns)",
+        ),
+    )
+
+
+def test_window_crossing_its_partition_period(check, example):
+    # The monitor's periods start at 38 ms (its PartitionPeriodStart window) and 88 ms; a
+    # second 10 ms window at 80 ms gives each period 9 ms on average but runs into the second.
+    monitor_window = (
+        '<Window_Schedule WindowIdentifier="5" WindowStartSeconds="0.038" '
+        'WindowDurationSeconds="0.008"\n                       PartitionPeriodStart="true"/>'
+    )
+    bad = (
+        two_periods_per_frame(example)
+        .replace('PeriodDurationSeconds="0.008"', 'PeriodDurationSeconds="0.009"')
+        .replace(
+            monitor_window,
+            f'{monitor_window}\n      <Window_Schedule WindowIdentifier="6" '
+            'WindowStartSeconds="0.08" WindowDurationSeconds="0.01"/>',
+        )
+    )
+    refused(
+        check,
+        bad,
+        at=bad.tag('<Window_Schedule WindowIdentifier="6"'),
+        element="Window_Schedule",
+        rule="a window stays within its partition period",
+        says=(
+            "window 6 of partition 'monitor' starts at 80000000 ns",
+            "past the end of its partition period at 88000000 ns",
+        ),
+    )
+
+
+# ---- what a schema error says ------------------------------------------------------------------
+
+
+def test_missing_required_number_says_it_is_missing(check, example):
+    # Not "MaxNbMessages='' is not a valid number": the attribute is not there at all.
+    bad = example.replace(
+        '<Queuing_Port Name="QP_CMD" MaxMessageSize="32" Direction="SOURCE" MaxNbMessages="8"/>',
+        '<Queuing_Port Name="QP_CMD" MaxMessageSize="32" Direction="SOURCE"/>',
+    )
+    refused(
+        check,
+        bad,
+        at=bad.tag('<Queuing_Port Name="QP_CMD"'),
+        element="Queuing_Port",
+        rule="schema ima653_module.xsd",
+        says=("The attribute 'MaxNbMessages' is required but missing",),
+    )
+
+
+def test_number_above_its_maximum_says_the_maximum(check, example):
+    bad = example.replace(
+        'Name="QP_CMD" MaxMessageSize="32" Direction="SOURCE" MaxNbMessages="8"',
+        'Name="QP_CMD" MaxMessageSize="32" Direction="SOURCE" MaxNbMessages="2000000"',
+    )
+    refused(
+        check,
+        bad,
+        at=bad.tag('MaxNbMessages="2000000"'),
+        element="Queuing_Port",
+        rule="numbers are within their range",
+        says=("MaxNbMessages='2000000' is too large: at most 1048576",),
+    )

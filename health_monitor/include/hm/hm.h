@@ -58,8 +58,9 @@ typedef struct {
 } hm_partition_table_t;
 
 /* The tables a module without HM tables gets: every error at partition level; partition
- * action IDLE (fail-stop), except a window overrun, IGNOREd (the partition is already stopped
- * for the rest of its window); module action IGNORE. */
+ * action IDLE (fail-stop) for faults, IGNORE for timing errors (a window overrun: the
+ * partition is already stopped for the rest of its window; a missed deadline: recorded, a
+ * host under load must not idle a healthy partition); module action IGNORE. */
 void hm_system_defaults(hm_system_table_t *t);
 void hm_partition_defaults(hm_partition_table_t *t);
 

@@ -60,7 +60,8 @@ def summary(outcomes: Sequence[Outcome]) -> tuple[str, int]:
 
 
 # The unit tests, built a second time with AddressSanitizer and UndefinedBehaviorSanitizer.
-SANITIZED_TARGETS = ("test_config", "test_port_buf", "test_plan", "test_hm")
+SANITIZED_TARGETS = ("test_config", "test_port_buf", "test_plan", "test_hm",
+                     "test_sandbox_policy")
 
 
 def sanitizer_commands(root: Path, build: Path) -> list[list[str]]:

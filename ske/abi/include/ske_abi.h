@@ -11,7 +11,7 @@
 #include <time.h>
 
 #define SKE_ABI_MAGIC 0x53414d49u /* "IMAS" */
-#define SKE_ABI_VERSION 2u
+#define SKE_ABI_VERSION 3u
 
 #define SKE_NAME_MAX 32 /* names carry at most 31 characters + NUL (ARINC allows 30) */
 #define SKE_MAX_PORTS 64 /* per partition */
@@ -20,6 +20,9 @@
 #define SKE_HM_STATES 4 /* hm_state_t values */
 #define SKE_HM_ERRORS 11 /* hm_error_t values, 0 unused */
 #define SKE_SCHEDULES 8 /* module schedules (ARINC 653 Part 2) */
+
+/* Sandbox flags (ske_ctl_t.sandbox_flags); the policy itself is in ske_sandbox.h. */
+#define SKE_SANDBOX_IO (1u << 0) /* a system partition: it may open files and sockets */
 
 /* Environment variable naming the control block's file descriptor in a partition. */
 #define SKE_ENV_CTL_FD "IMA_SKE_CTL_FD"
@@ -107,7 +110,7 @@ typedef struct {
     uint32_t start_condition; /* APEX START_CONDITION_TYPE */
     uint32_t initial_mode; /* COLD_START or WARM_START */
     uint32_t n_ports;
-    uint32_t pad0;
+    uint32_t sandbox_flags; /* SKE_SANDBOX_*: what the partition's system-call filter allows */
     ske_port_desc_t ports[SKE_MAX_PORTS];
 
     /* Hand-over. */

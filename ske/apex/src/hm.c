@@ -257,7 +257,8 @@ void apex__hm_check_deadlines(void)
     int64_t now = apex__now();
     for (int i = 0; i < rt->n_procs; i++) {
         apex_proc_t *p = &rt->procs[i];
-        if (p->deadline_missed || p->deadline_time == INFINITE_TIME_VALUE || p->deadline_time >= now)
+        /* A deadline is the time by which the work is done: still at it then, it missed. */
+        if (p->deadline_missed || p->deadline_time == INFINITE_TIME_VALUE || p->deadline_time > now)
             continue;
         if (p->state == DORMANT || (p->state == WAITING && p->wait == WAIT_PERIOD))
             continue;

@@ -2,6 +2,7 @@
 /* The APEX run-time of a partition: attaches to the SKE before main() runs, schedules the
  * partition's ARINC processes one at a time, and hands the CPU back when all of them wait. */
 #include "apex__rt.h"
+#include "apex__sandbox.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -65,9 +66,10 @@ void apex__yield_cpu(void)
     wait_grant();
 }
 
-/* Runs before main(): the partition's initialisation process starts inside its first
- * window, never before. */
-__attribute__((constructor)) static void apex_attach(void)
+/* Runs before main() and before the partition's own constructors (101 is the first priority
+ * a program may use): the partition's code starts inside its first window, under its system-
+ * call filter, holding no port descriptor. */
+__attribute__((constructor(101))) static void apex_attach(void)
 {
     const char *s = getenv(SKE_ENV_CTL_FD);
     if (!s)
@@ -95,6 +97,8 @@ __attribute__((constructor)) static void apex_attach(void)
     rt->seen_grant = 0;
     apex__ports_attach();
     apex__hm_init();
+    if (apex__sandbox_install(rt->ctl) != 0)
+        fatal("apex: cannot install the partition's system-call filter");
     atomic_store(&rt->ctl->ready, 1);
     ske_futex_wake(&rt->ctl->ready);
     wait_grant();

@@ -32,8 +32,9 @@ extern char **environ;
 #define HANG_MIN_NS 2000000000LL /* time (at least 2 s) while using no CPU before it is cut */
 #define SAMPLE_LIMIT 2000000
 /* A partition that handed the CPU back has a few microseconds of system-call tail; more than
- * this much CPU before its next window means it went on computing. */
-#define OUTSIDE_LIMIT_NS 2000000
+ * this much CPU before its next window means it went on computing. Above a scheduler tick
+ * (4 ms at 250 Hz): the CPU clock of a process running on another CPU may lag by one. */
+#define OUTSIDE_LIMIT_NS 5000000
 #define RT_SPIN_NS 200000 /* real-time mode: spin this long before a window starts */
 #define SYSTEM_MESSAGE_MAX (1u << 20) /* the largest MaxMessageSize the schema accepts */
 

@@ -279,6 +279,11 @@ def run_lines(stats: Mapping[str, Any]) -> list[str]:
     if stats.get("exit_reason") not in (None, "frames"):
         first += f", ended by {stats['exit_reason']}"
     lines = [first]
+    hm_events = stats.get("hm_events")
+    if hm_events:
+        restarts = sum(p.get("restarts") or 0 for p in stats.get("partitions") or [])
+        lines.append(f"Health monitor: {hm_events} decisions, {restarts} partition restarts "
+                     "(the trace's hm events say which)")
     switch = stats.get("window_switch_us")
     if switch:
         lines.append(

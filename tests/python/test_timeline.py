@@ -39,3 +39,12 @@ def test_partitions_sharing_an_initial_get_distinct_letters():
         ],
     }
     assert "".join(ch for ch, _ in timeline(stats, width=3)) == "SIT"
+
+
+def test_the_run_lines_count_health_monitor_decisions():
+    from ima.ske import run_lines
+
+    stats = {"mode": "emulated", "frames": 10, "emulated_ns": 500_000_000, "wall_s": 0.01,
+             "hm_events": 7, "partitions": [{"restarts": 2}, {"restarts": 1}]}
+    assert "Health monitor: 7 decisions, 3 partition restarts" in "\n".join(run_lines(stats))
+    assert not any("Health monitor" in line for line in run_lines({**stats, "hm_events": 0}))

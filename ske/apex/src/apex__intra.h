@@ -58,6 +58,9 @@ extern apex_intra_t apex__intra;
 bool apex__name_valid(const char *name);
 /* Names compare on at most MAX_NAME_LENGTH characters. */
 bool apex__name_equal(const char *a, const char *b);
+/* Index of the object called `name` among n objects of `stride` bytes, each starting with
+ * its NAME_TYPE name (buffers, blackboards, semaphores, events), or -1. */
+int apex__find_named(const void *objects, size_t stride, int n, const char *name);
 void apex__name_copy(NAME_TYPE dst, const char *src);
 
 /* Copies a message from or to memory the caller named (a bad address there is the caller's

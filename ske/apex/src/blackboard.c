@@ -28,11 +28,10 @@ void CREATE_BLACKBOARD(
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
-    for (int i = 0; i < in->n_blackboards; i++)
-        if (apex__name_equal(in->blackboards[i].name, BLACKBOARD_NAME)) {
-            *RETURN_CODE = NO_ACTION;
-            return;
-        }
+    if (apex__find_named(in->blackboards, sizeof in->blackboards[0], in->n_blackboards, BLACKBOARD_NAME) >= 0) {
+        *RETURN_CODE = NO_ACTION;
+        return;
+    }
     if (MAX_MESSAGE_SIZE <= 0 || MAX_MESSAGE_SIZE > SYSTEM_LIMIT_MESSAGE_SIZE) {
         *RETURN_CODE = INVALID_PARAM;
         return;
@@ -147,14 +146,15 @@ void GET_BLACKBOARD_ID(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex__sync();
-    if (BLACKBOARD_NAME && BLACKBOARD_ID)
-        for (int i = 0; i < apex__intra.n_blackboards; i++)
-            if (apex__name_equal(apex__intra.blackboards[i].name, BLACKBOARD_NAME)) {
-                *BLACKBOARD_ID = i + 1;
-                *RETURN_CODE = NO_ERROR;
-                return;
-            }
-    *RETURN_CODE = INVALID_CONFIG;
+    int k = BLACKBOARD_ID ? apex__find_named(apex__intra.blackboards, sizeof apex__intra.blackboards[0],
+                                      apex__intra.n_blackboards, BLACKBOARD_NAME)
+                 : -1;
+    if (k < 0) {
+        *RETURN_CODE = INVALID_CONFIG;
+        return;
+    }
+    *BLACKBOARD_ID = k + 1;
+    *RETURN_CODE = NO_ERROR;
 }
 
 void GET_BLACKBOARD_STATUS(

@@ -54,11 +54,10 @@ void CREATE_BUFFER(
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
-    for (int i = 0; i < in->n_buffers; i++)
-        if (apex__name_equal(in->buffers[i].name, BUFFER_NAME)) {
-            *RETURN_CODE = NO_ACTION;
-            return;
-        }
+    if (apex__find_named(in->buffers, sizeof in->buffers[0], in->n_buffers, BUFFER_NAME) >= 0) {
+        *RETURN_CODE = NO_ACTION;
+        return;
+    }
     if (MAX_MESSAGE_SIZE <= 0 || MAX_MESSAGE_SIZE > SYSTEM_LIMIT_MESSAGE_SIZE ||
         MAX_NB_MESSAGE <= 0 || MAX_NB_MESSAGE > SYSTEM_LIMIT_NUMBER_OF_MESSAGES ||
         (QUEUING_DISCIPLINE != FIFO && QUEUING_DISCIPLINE != PRIORITY)) {
@@ -187,14 +186,15 @@ void GET_BUFFER_ID(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex__sync();
-    if (BUFFER_NAME && BUFFER_ID)
-        for (int i = 0; i < apex__intra.n_buffers; i++)
-            if (apex__name_equal(apex__intra.buffers[i].name, BUFFER_NAME)) {
-                *BUFFER_ID = i + 1;
-                *RETURN_CODE = NO_ERROR;
-                return;
-            }
-    *RETURN_CODE = INVALID_CONFIG;
+    int k = BUFFER_ID ? apex__find_named(apex__intra.buffers, sizeof apex__intra.buffers[0],
+                                      apex__intra.n_buffers, BUFFER_NAME)
+                 : -1;
+    if (k < 0) {
+        *RETURN_CODE = INVALID_CONFIG;
+        return;
+    }
+    *BUFFER_ID = k + 1;
+    *RETURN_CODE = NO_ERROR;
 }
 
 void GET_BUFFER_STATUS(

@@ -26,11 +26,10 @@ void CREATE_EVENT(
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
-    for (int i = 0; i < in->n_events; i++)
-        if (apex__name_equal(in->events[i].name, EVENT_NAME)) {
-            *RETURN_CODE = NO_ACTION;
-            return;
-        }
+    if (apex__find_named(in->events, sizeof in->events[0], in->n_events, EVENT_NAME) >= 0) {
+        *RETURN_CODE = NO_ACTION;
+        return;
+    }
     if (apex__rt.mode == NORMAL) {
         *RETURN_CODE = INVALID_MODE;
         return;
@@ -113,14 +112,15 @@ void GET_EVENT_ID(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex__sync();
-    if (EVENT_NAME && EVENT_ID)
-        for (int i = 0; i < apex__intra.n_events; i++)
-            if (apex__name_equal(apex__intra.events[i].name, EVENT_NAME)) {
-                *EVENT_ID = i + 1;
-                *RETURN_CODE = NO_ERROR;
-                return;
-            }
-    *RETURN_CODE = INVALID_CONFIG;
+    int k = EVENT_ID ? apex__find_named(apex__intra.events, sizeof apex__intra.events[0],
+                                      apex__intra.n_events, EVENT_NAME)
+                 : -1;
+    if (k < 0) {
+        *RETURN_CODE = INVALID_CONFIG;
+        return;
+    }
+    *EVENT_ID = k + 1;
+    *RETURN_CODE = NO_ERROR;
 }
 
 void GET_EVENT_STATUS(

@@ -20,6 +20,14 @@ bool apex__name_equal(const char *a, const char *b)
     return la == lb && memcmp(a, b, la) == 0;
 }
 
+int apex__find_named(const void *objects, size_t stride, int n, const char *name)
+{
+    for (int i = 0; name && i < n; i++)
+        if (apex__name_equal((const char *)objects + (size_t)i * stride, name))
+            return i;
+    return -1;
+}
+
 void apex__name_copy(NAME_TYPE dst, const char *src)
 {
     memset(dst, 0, sizeof(NAME_TYPE));

@@ -30,11 +30,10 @@ void CREATE_SEMAPHORE(
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
-    for (int i = 0; i < in->n_semaphores; i++)
-        if (apex__name_equal(in->semaphores[i].name, SEMAPHORE_NAME)) {
-            *RETURN_CODE = NO_ACTION;
-            return;
-        }
+    if (apex__find_named(in->semaphores, sizeof in->semaphores[0], in->n_semaphores, SEMAPHORE_NAME) >= 0) {
+        *RETURN_CODE = NO_ACTION;
+        return;
+    }
     if (CURRENT_VALUE < 0 || CURRENT_VALUE > MAX_SEMAPHORE_VALUE || MAXIMUM_VALUE < 0 ||
         MAXIMUM_VALUE > MAX_SEMAPHORE_VALUE || CURRENT_VALUE > MAXIMUM_VALUE ||
         (QUEUING_DISCIPLINE != FIFO && QUEUING_DISCIPLINE != PRIORITY)) {
@@ -117,14 +116,15 @@ void GET_SEMAPHORE_ID(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex__sync();
-    if (SEMAPHORE_NAME && SEMAPHORE_ID)
-        for (int i = 0; i < apex__intra.n_semaphores; i++)
-            if (apex__name_equal(apex__intra.semaphores[i].name, SEMAPHORE_NAME)) {
-                *SEMAPHORE_ID = i + 1;
-                *RETURN_CODE = NO_ERROR;
-                return;
-            }
-    *RETURN_CODE = INVALID_CONFIG;
+    int k = SEMAPHORE_ID ? apex__find_named(apex__intra.semaphores, sizeof apex__intra.semaphores[0],
+                                      apex__intra.n_semaphores, SEMAPHORE_NAME)
+                 : -1;
+    if (k < 0) {
+        *RETURN_CODE = INVALID_CONFIG;
+        return;
+    }
+    *SEMAPHORE_ID = k + 1;
+    *RETURN_CODE = NO_ERROR;
 }
 
 void GET_SEMAPHORE_STATUS(

@@ -146,9 +146,10 @@ void GET_BLACKBOARD_ID(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex__sync();
-    int k = BLACKBOARD_ID ? apex__find_named(apex__intra.blackboards, sizeof apex__intra.blackboards[0],
-                                      apex__intra.n_blackboards, BLACKBOARD_NAME)
-                 : -1;
+    int k = -1;
+    if (BLACKBOARD_ID)
+        k = apex__find_named(apex__intra.blackboards, sizeof apex__intra.blackboards[0],
+                             apex__intra.n_blackboards, BLACKBOARD_NAME);
     if (k < 0) {
         *RETURN_CODE = INVALID_CONFIG;
         return;

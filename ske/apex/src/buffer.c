@@ -186,9 +186,10 @@ void GET_BUFFER_ID(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex__sync();
-    int k = BUFFER_ID ? apex__find_named(apex__intra.buffers, sizeof apex__intra.buffers[0],
-                                      apex__intra.n_buffers, BUFFER_NAME)
-                 : -1;
+    int k = -1;
+    if (BUFFER_ID)
+        k = apex__find_named(apex__intra.buffers, sizeof apex__intra.buffers[0],
+                             apex__intra.n_buffers, BUFFER_NAME);
     if (k < 0) {
         *RETURN_CODE = INVALID_CONFIG;
         return;

@@ -112,9 +112,10 @@ void GET_EVENT_ID(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex__sync();
-    int k = EVENT_ID ? apex__find_named(apex__intra.events, sizeof apex__intra.events[0],
-                                      apex__intra.n_events, EVENT_NAME)
-                 : -1;
+    int k = -1;
+    if (EVENT_ID)
+        k = apex__find_named(apex__intra.events, sizeof apex__intra.events[0],
+                             apex__intra.n_events, EVENT_NAME);
     if (k < 0) {
         *RETURN_CODE = INVALID_CONFIG;
         return;

@@ -116,9 +116,10 @@ void GET_SEMAPHORE_ID(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex__sync();
-    int k = SEMAPHORE_ID ? apex__find_named(apex__intra.semaphores, sizeof apex__intra.semaphores[0],
-                                      apex__intra.n_semaphores, SEMAPHORE_NAME)
-                 : -1;
+    int k = -1;
+    if (SEMAPHORE_ID)
+        k = apex__find_named(apex__intra.semaphores, sizeof apex__intra.semaphores[0],
+                             apex__intra.n_semaphores, SEMAPHORE_NAME);
     if (k < 0) {
         *RETURN_CODE = INVALID_CONFIG;
         return;

@@ -1122,6 +1122,7 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
         atomic_store_explicit(&p->ctl->grant_seq, p->grant_seq, memory_order_release);
         ske_futex_wake(&p->ctl->grant_seq);
         p->windows++;
+        pid_t granted_pid = p->pid;
         r = wait_yield(s, p, w->duration_ns, s->epoch_mono_ns + end, cpu0, &cause);
         /* A partition that posted an error waits for the decision: take it now and, if the
          * partition goes on (IGNORE), give it the rest of its window, still on the same
@@ -1142,7 +1143,10 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
             ske_futex_wake(&p->ctl->grant_seq);
             r = wait_yield(s, p, w->duration_ns, s->epoch_mono_ns + end, cpu0, &cause);
         }
-        int64_t cpu1 = cpu_now(p);
+        /* A process restarted by the health monitor has a clock of its own: this window's
+         * accounting is the granted process's only. */
+        bool same = p->pid == granted_pid;
+        int64_t cpu1 = same ? cpu_now(p) : -1;
         if (r == W_OVERRUN) {
             /* No waiting for the stop to take effect: a process with SIGSTOP pending cannot
              * return to user space, so it computes nothing more whether it is on a CPU now or
@@ -1160,8 +1164,8 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
         }
         if (cpu0 >= 0 && cpu1 >= 0)
             p->cpu_ns += cpu1 - cpu0;
-        p->cpu_at_yield_ns = r == W_YIELD ? cpu1 : -1;
-        if (r == W_YIELD) {
+        p->cpu_at_yield_ns = r == W_YIELD && same ? cpu1 : -1;
+        if (r == W_YIELD && same) {
             int64_t wake = atomic_load(&p->ctl->wake_mono_ns);
             int64_t yield = atomic_load(&p->ctl->yield_mono_ns);
             if (rt) {

@@ -84,15 +84,6 @@ int64_t ske_plan_partition_ns_in(const ske_module_cfg_t *m, int schedule, int pi
     return sum;
 }
 
-int ske_plan_windows_in(const ske_module_cfg_t *m, int schedule, int pi)
-{
-    int first, n, count = 0;
-    range(m, schedule, &first, &n);
-    for (int i = first; i < first + n; i++)
-        count += m->windows[i].partition == pi;
-    return count;
-}
-
 int64_t ske_plan_partition_ns(const ske_module_cfg_t *m, int pi)
 {
     return ske_plan_partition_ns_in(m, m->n_schedules ? m->initial_schedule : 0, pi);

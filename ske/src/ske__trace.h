@@ -18,7 +18,6 @@ typedef struct {
 int ske_trace_open(ske_trace_t *t, const char *path, const char *node);
 /* Flushes and closes; a negative errno if anything written was lost (disk full, ...). */
 int ske_trace_close(ske_trace_t *t);
-static inline bool ske_trace_on(const ske_trace_t *t) { return t->f != NULL; }
 /* An event is begin, fields, end. All are no-ops when the trace is off. */
 void ske_trace_begin(ske_trace_t *t, int64_t t_ns, const char *src, const char *kind);
 void ske_trace_str(ske_trace_t *t, const char *key, const char *val);

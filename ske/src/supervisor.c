@@ -1308,6 +1308,23 @@ fail:
     return rc;
 }
 
+/* The module's windows as a JSON array: the trace's module_start and the statistics. */
+static void write_windows_json(FILE *f, const ske_module_cfg_t *m)
+{
+    fputc('[', f);
+    for (int i = 0; i < m->n_windows; i++) {
+        const ske_window_cfg_t *w = &m->windows[i];
+        fprintf(f, "%s{\"window\":%d,\"partition\":", i ? "," : "", w->id);
+        ske_json_escape(f, m->partitions[w->partition].name, strlen(m->partitions[w->partition].name));
+        fprintf(f, ",\"offset_ns\":%" PRId64 ",\"duration_ns\":%" PRId64, w->offset_ns,
+                w->duration_ns);
+        if (m->n_schedules > 1)
+            fprintf(f, ",\"schedule\":%d", m->schedules[w->schedule].id);
+        fputc('}', f);
+    }
+    fputc(']', f);
+}
+
 static void trace_schedule(ske_t *s)
 {
     const ske_module_cfg_t *m = s->cfg;
@@ -1316,19 +1333,8 @@ static void trace_schedule(ske_t *s)
     ske_trace_str(&s->trace, "time_mode", s->time_mode == SKE_TIME_REALTIME ? "realtime" : "emulated");
     ske_trace_int(&s->trace, "major_frame_ns", m->major_frame_ns);
     if (s->trace.f) {
-        fputs(",\"windows\":[", s->trace.f);
-        for (int i = 0; i < m->n_windows; i++) {
-            const ske_window_cfg_t *w = &m->windows[i];
-            fprintf(s->trace.f, "%s{\"window\":%d,\"partition\":", i ? "," : "", w->id);
-            ske_json_escape(s->trace.f, m->partitions[w->partition].name,
-                            strlen(m->partitions[w->partition].name));
-            fprintf(s->trace.f, ",\"offset_ns\":%" PRId64 ",\"duration_ns\":%" PRId64, w->offset_ns,
-                    w->duration_ns);
-            if (m->n_schedules > 1)
-                fprintf(s->trace.f, ",\"schedule\":%d", m->schedules[w->schedule].id);
-            fputc('}', s->trace.f);
-        }
-        fputc(']', s->trace.f);
+        fputs(",\"windows\":", s->trace.f);
+        write_windows_json(s->trace.f, m);
         if (m->n_schedules > 1)
             fprintf(s->trace.f, ",\"initial_schedule\":%d", m->schedules[m->initial_schedule].id);
     }
@@ -1378,18 +1384,9 @@ static int write_stats(ske_t *s, double wall_s)
         fprintf(f, ",\"cpu_outside_windows_ns_max\":%" PRId64 "}", p->cpu_outside_max_ns);
     }
     fprintf(f, "],\"hm_events\":%llu", (unsigned long long)s->hm_events);
-    fputs(",\"windows\":[", f);
-    for (int i = 0; i < m->n_windows; i++) {
-        const ske_window_cfg_t *w = &m->windows[i];
-        fprintf(f, "%s{\"window\":%d,\"partition\":", i ? "," : "", w->id);
-        ske_json_escape(f, m->partitions[w->partition].name, strlen(m->partitions[w->partition].name));
-        fprintf(f, ",\"offset_ns\":%" PRId64 ",\"duration_ns\":%" PRId64, w->offset_ns,
-                w->duration_ns);
-        if (m->n_schedules > 1)
-            fprintf(f, ",\"schedule\":%d", m->schedules[w->schedule].id);
-        fputc('}', f);
-    }
-    fputs("],\"window_switch_us\":", f);
+    fputs(",\"windows\":", f);
+    write_windows_json(f, m);
+    fputs(",\"window_switch_us\":", f);
     ske_samples_json_us(&s->switch_ns, f);
     fputs(",\"jitter_us\":", f);
     ske_samples_json_us(&s->jitter_ns, f);

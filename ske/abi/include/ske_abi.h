@@ -11,7 +11,7 @@
 #include <time.h>
 
 #define SKE_ABI_MAGIC 0x53414d49u /* "IMAS" */
-#define SKE_ABI_VERSION 3u
+#define SKE_ABI_VERSION 4u
 
 #define SKE_NAME_MAX 32 /* names carry at most 31 characters + NUL (ARINC allows 30) */
 #define SKE_MAX_PORTS 64 /* per partition */
@@ -117,7 +117,6 @@ typedef struct {
     _Atomic uint32_t grant_seq;
     _Atomic uint32_t yield_seq;
     _Atomic uint32_t ready; /* partition set it once attached and waiting for its first grant */
-    _Atomic uint32_t stop_request; /* SKE asks the partition to exit at its next grant */
     _Atomic uint32_t ske_sleeping; /* the SKE sleeps on yield_seq: a yield must wake it */
     uint32_t pad_sleeping;
     _Atomic int64_t win_start_ns; /* current window, partition time */
@@ -142,7 +141,6 @@ typedef struct {
     _Atomic uint32_t hm_seq; /* partition: incremented when it posts an error */
     _Atomic uint32_t hm_ack; /* SKE: the hm_seq it has acted on */
     uint32_t hm_error; /* hm_error_t */
-    uint32_t hm_level_posted; /* hm_level_t */
     uint32_t hm_state; /* hm_state_t */
     uint32_t hm_fatal; /* the reporting context cannot go on (a fault in initialisation) */
     int32_t hm_process; /* failed process id, 0 = the initialisation process */

@@ -150,8 +150,6 @@ void apex__user_copy(bool on);
 /* Health monitoring hooks of the run-time (hm.c). */
 void apex__hm_init(void);
 void apex__hm_check_deadlines(void);
-/* The ready process to run next, the error handler first. */
-apex_proc_t *apex__pick(void);
 /* Completes port waits whose condition now holds (scheduler side). */
 void apex__service_port_waiters(void);
 /* Messages waiting in a queuing port, and whether any process waits on it. */

@@ -95,14 +95,13 @@ static void trace_process_level(hm_error_t err, const apex_proc_t *p, const char
     apex__event(SKE_EV_HM, (int32_t)err, p->id, text, (uint32_t)(SKE_NAME_MAX + n));
 }
 
-/* Posts an error for the SKE and waits until it has decided; if it idles or restarts the
- * partition, this process never runs again. */
-static void post_and_wait(hm_error_t err, hm_level_t level, hm_state_t st, const apex_proc_t *p,
+/* Posts an error for the SKE and waits until it has decided (it finds the level in its own
+ * copy of the tables); if it idles or restarts the partition, this process never runs again. */
+static void post_and_wait(hm_error_t err, hm_state_t st, const apex_proc_t *p,
                           const char *msg, size_t len, bool fatal)
 {
     ske_ctl_t *c = apex__rt.ctl;
     c->hm_error = err;
-    c->hm_level_posted = level;
     c->hm_state = st;
     c->hm_fatal = fatal;
     c->hm_process = p ? p->id : 0;
@@ -147,9 +146,7 @@ static void raise_error(apex_proc_t *failed, hm_state_t st, hm_error_t err, cons
     }
     /* Partition or module level (a process-level error with no handler goes to the
      * partition level, as the standard says). */
-    if (level == HM_LEVEL_PROCESS)
-        level = HM_LEVEL_PARTITION;
-    post_and_wait(err, level, st, failed, msg, len, fatal && !failed);
+    post_and_wait(err, st, failed, msg, len, fatal && !failed);
     if (!fatal)
         return;
     if (failed) {

@@ -33,8 +33,6 @@ static void take_grant(void)
     rt->win_end = atomic_load(&c->win_end_ns);
     if (!rt->realtime && rt->now < rt->win_start)
         rt->now = rt->win_start;
-    if (atomic_load(&c->stop_request))
-        _exit(0);
 }
 
 static void wait_grant(void)
@@ -206,8 +204,6 @@ static apex_proc_t *pick(void)
     }
     return best;
 }
-
-apex_proc_t *apex__pick(void) { return pick(); }
 
 bool apex__may_block(void)
 {

@@ -30,7 +30,6 @@ void ske_plan_at(const ske_module_cfg_t *m, int64_t t, ske_slot_t *slot);
 /* Window time per major frame given to partition `pi` in a schedule, and time given to
  * nobody; the _initial forms are for the initial schedule. */
 int64_t ske_plan_partition_ns_in(const ske_module_cfg_t *m, int schedule, int pi);
-int ske_plan_windows_in(const ske_module_cfg_t *m, int schedule, int pi);
 int64_t ske_plan_partition_ns(const ske_module_cfg_t *m, int pi);
 int64_t ske_plan_idle_ns(const ske_module_cfg_t *m);
 

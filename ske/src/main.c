@@ -38,6 +38,9 @@ static void usage(FILE *f)
           "  --partition-path DIRS colon-separated folders searched for partition programs\n"
           "                        (default: $IMA_PARTITION_PATH)\n"
           "  --check               validate the module and exit\n"
+          "  --lockstep SOCKET     advance time in the quanta of the CAN bus at SOCKET (a flight);\n"
+          "                        runs until the bus ends the run\n"
+          "  --node-index N        this node's number on the bus (redundancy channel), 0..3\n"
           "  -q, --quiet           print nothing but errors\n"
           "exit status: 0 done, 1 run-time failure, 2 usage or invalid module,\n"
           "             3 shut down by the health monitor (module-level SHUTDOWN), 128+N stopped by signal N\n",
@@ -57,7 +60,7 @@ static int parse_frames(const char *s, int64_t *out)
 
 int main(int argc, char **argv)
 {
-    enum { O_FRAMES = 1000, O_REALTIME, O_EMULATED, O_TRACE, O_STATS, O_NODE, O_SCHEMA, O_PPATH, O_CHECK };
+    enum { O_FRAMES = 1000, O_REALTIME, O_EMULATED, O_TRACE, O_STATS, O_NODE, O_SCHEMA, O_PPATH, O_CHECK, O_LOCKSTEP, O_NODE_INDEX };
     static const struct option longopts[] = {
         {"frames", required_argument, NULL, O_FRAMES},
         {"realtime", no_argument, NULL, O_REALTIME},
@@ -68,6 +71,8 @@ int main(int argc, char **argv)
         {"schema", required_argument, NULL, O_SCHEMA},
         {"partition-path", required_argument, NULL, O_PPATH},
         {"check", no_argument, NULL, O_CHECK},
+        {"lockstep", required_argument, NULL, O_LOCKSTEP},
+        {"node-index", required_argument, NULL, O_NODE_INDEX},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
@@ -89,6 +94,16 @@ int main(int argc, char **argv)
         case O_TRACE: ro.trace_path = optarg; break;
         case O_STATS: ro.stats_path = optarg; break;
         case O_NODE: ro.node = optarg; break;
+        case O_LOCKSTEP: ro.lockstep_path = optarg; break;
+        case O_NODE_INDEX: {
+            int64_t v;
+            if (parse_frames(optarg, &v) != 0 || v > 3) {
+                fprintf(stderr, "ima-ske: error: --node-index wants 0..3, not '%s'\n", optarg);
+                return 2;
+            }
+            ro.node_index = (uint32_t)v;
+            break;
+        }
         case O_SCHEMA: lo.schema_dir = optarg; break;
         case O_PPATH: lo.partition_path = optarg; break;
         case O_CHECK: check = true; break;

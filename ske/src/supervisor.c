@@ -20,6 +20,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "canbus/client.h"
 #include "ske__sandbox.h"
 #include "ske__stats.h"
 #include "ske__trace.h"
@@ -105,6 +106,9 @@ struct ske {
     volatile sig_atomic_t stop_signal;
     volatile sig_atomic_t child_event;
     char exit_reason[16];
+    bool on_bus; /* windows wait for the CAN bus's time quanta */
+    bool bus_stopped; /* the bus ended the run */
+    canbus_client_t bus;
 };
 
 static const char *state_name(pstate_t s)
@@ -1411,6 +1415,31 @@ static int write_stats(ske_t *s, double wall_s)
     return rc;
 }
 
+/* Lockstep: a window starting at t runs only once the bus has granted time past t; until then
+ * the node reports its quantum done and waits for the next one (nodes/include/canbus/proto.h). */
+static int wait_for_quantum(ske_t *s, int64_t t, char *err, size_t errlen)
+{
+    while (t >= s->bus.granted_ns) {
+        int r = canbus_client_done_wait(&s->bus);
+        if (r == CANBUS_STOPPED) {
+            s->bus_stopped = true;
+            return SKE_OK;
+        }
+        if (r == -EINTR) {
+            if (s->stop_signal)
+                return SKE_OK;
+            if (s->child_event)
+                reap(s);
+            continue;
+        }
+        if (r < 0) {
+            snprintf(err, errlen, "CAN bus: %s", strerror(-r));
+            return SKE_E_IO;
+        }
+    }
+    return SKE_OK;
+}
+
 int ske_run(ske_t *s, char *err, size_t errlen)
 {
     const ske_module_cfg_t *m = s->cfg;
@@ -1423,6 +1452,18 @@ int ske_run(ske_t *s, char *err, size_t errlen)
     if (s->time_mode == SKE_TIME_REALTIME)
         prctl(PR_SET_TIMERSLACK, 1UL); /* the default 50 µs slack would be window jitter */
     s->epoch_mono_ns = s->start_mono_ns; /* refined below for real-time mode */
+    if (s->opts.lockstep_path) {
+        char berr[256];
+        int brc = canbus_client_connect(&s->bus, s->opts.lockstep_path, s->node,
+                                        CANBUS_ROLE_LOCKSTEP, s->opts.node_index, berr, sizeof berr);
+        if (brc != CANBUS_OK) {
+            snprintf(err, errlen, "%s", berr);
+            snprintf(s->exit_reason, sizeof s->exit_reason, "error");
+            rc = SKE_E_IO;
+            goto done;
+        }
+        s->on_bus = true;
+    }
     for (int i = 0; i < m->n_partitions && rc == SKE_OK; i++)
         rc = spawn(s, &s->parts[i], err, errlen);
     if (rc != SKE_OK) {
@@ -1446,6 +1487,10 @@ int ske_run(ske_t *s, char *err, size_t errlen)
             snprintf(s->exit_reason, sizeof s->exit_reason, "end_of_time");
             break;
         }
+        if (s->on_bus && (rc = wait_for_quantum(s, slot.start_ns, err, errlen)) != SKE_OK)
+            break;
+        if (s->bus_stopped || s->stop_signal)
+            break;
         if (slot.index == 0 && m->n_schedules && s->next_schedule != slot.schedule)
             switch_schedule(s, &slot, s->next_schedule);
         if (slot.index == 0 && s->hm_reset) {
@@ -1467,7 +1512,11 @@ int ske_run(ske_t *s, char *err, size_t errlen)
         snprintf(s->exit_reason, sizeof s->exit_reason, "signal");
     else if (s->hm_shutdown)
         snprintf(s->exit_reason, sizeof s->exit_reason, "hm_shutdown");
+    else if (s->bus_stopped)
+        snprintf(s->exit_reason, sizeof s->exit_reason, "bus_stop");
 done:
+    if (s->on_bus)
+        canbus_client_close(&s->bus);
     for (int i = 0; i < m->n_partitions; i++)
         kill_partition(&s->parts[i]);
     /* A shutdown mid-frame stops at the end of the window where it was decided. */

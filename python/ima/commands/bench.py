@@ -26,6 +26,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         metavar="N",
         help="major frames per measurement (default: the benchmark's own)",
     )
+    fl = targets.add_parser(
+        "flight", help="flight loop: speed-up of a 10-minute flight, CAN bus frames/s, peak memory"
+    )
+    fl.add_argument("--json", action="store_true", help="print the results as JSON")
+    fl.add_argument("--duration", type=positive_int, default=600, metavar="SECONDS",
+                    help="emulated flight time (default 600)")
     return parser
 
 
@@ -34,4 +40,8 @@ def run(args: argparse.Namespace) -> int:
         from ima.bench import ske
 
         return ske.run(frames=args.frames, json_out=args.json) or 0
+    if args.target == "flight":
+        from ima.bench import flight
+
+        return flight.run(json_out=args.json, duration_s=float(args.duration)) or 0
     raise AssertionError(f"unhandled bench target {args.target}")  # argparse restricts it

@@ -61,14 +61,18 @@ def summary(outcomes: Sequence[Outcome]) -> tuple[str, int]:
 
 # The unit tests, built a second time with AddressSanitizer and UndefinedBehaviorSanitizer.
 SANITIZED_TARGETS = ("test_config", "test_port_buf", "test_plan", "test_hm",
-                     "test_sandbox_policy")
+                     "test_sandbox_policy", "test_canbus_wire", "test_canbus_socket",
+                     "nav_fcs_test_nf_math", "nav_fcs_test_nav", "nav_fcs_test_fcs")
+# Built with them because a sanitized test runs it.
+SANITIZED_HELPERS = ("ima-canbus",)
 
 
 def sanitizer_commands(root: Path, build: Path) -> list[list[str]]:
     """Configure and build the sanitized unit tests in `build` (a tree of their own)."""
     configure = ["cmake", "-S", str(root), "-B", str(build), "-G", "Ninja",
                  "-DIMA_SANITIZE=ON", "-DCMAKE_BUILD_TYPE=Debug"]
-    return [configure, ["cmake", "--build", str(build), "--target", *SANITIZED_TARGETS]]
+    return [configure, ["cmake", "--build", str(build), "--target", *SANITIZED_TARGETS,
+                                   *SANITIZED_HELPERS]]
 
 
 def ctest_command(build: Path) -> list[str]:

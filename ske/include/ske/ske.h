@@ -18,6 +18,8 @@ typedef struct {
     const char *trace_path; /* JSON lines, "-" for stdout, NULL for none */
     const char *stats_path; /* JSON summary written at the end, NULL for none */
     const char *node; /* node name in the trace; NULL: the module's */
+    const char *lockstep_path; /* CAN bus socket whose time quanta gate the windows, or NULL */
+    uint32_t node_index; /* node (redundancy channel) number given to the bus, 0 for none */
     bool quiet;
 } ske_run_opts_t;
 

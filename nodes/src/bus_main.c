@@ -1,0 +1,229 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The ima-canbus command line: options, signals, exit status. */
+#include "canbus__bus.h"
+
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Exit status: 0 the run ended (end time, a client's STOP, SIGINT/SIGTERM), 1 the bus
+ * failed (socket, trace or stats file, memory), 2 bad command line. */
+enum { EXIT_USAGE = 2 };
+
+static void usage(FILE *f)
+{
+    fputs("usage: ima-canbus --socket PATH [options]\n"
+          "  --bitrate BIT/S          bit rate (1000000)\n"
+          "  --quantum-us US          lockstep quantum (5000)\n"
+          "  --lockstep-clients N     LOCKSTEP clients to wait for before T=0 (0: free-running)\n"
+          "  --duration SECONDS | --end-ns NS   end of the run (none: until STOP or a signal)\n"
+          "  --realtime               pace quanta by CLOCK_MONOTONIC\n"
+          "  --trace FILE             JSON-lines trace ('-' for stdout)\n"
+          "  --stats FILE             JSON statistics at exit ('-' for stdout)\n"
+          "  --max-clients N          connected clients at most (64)\n"
+          "  --fault KIND:KEY=VAL,... arm a fault (see nodes/README.md); repeatable\n"
+          "  --bus-off-recovery       clients recover from bus-off after 128 x 11 bit times\n"
+          "  --max-rejects N          disconnect a client after N+1 rejected records (100)\n"
+          "  --send-timeout-ms MS     stall allowed to a non-lockstep client (2000)\n"
+          "  --client-buffer BYTES    output the bus queues per client before waiting (8 MiB)\n"
+          "  --gap-bits N             idle bits after each frame beyond its interframe space (0)\n"
+          "  -q, --quiet              no progress messages\n",
+          f);
+}
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    canbus_signalled = 1;
+}
+
+static int parse_i64(const char *s, int64_t lo, int64_t hi, int64_t *out)
+{
+    char *end;
+    errno = 0;
+    long long v = strtoll(s, &end, 0);
+    if (end == s || *end || errno || v < lo || v > hi)
+        return -1;
+    *out = v;
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    enum {
+        O_SOCKET = 256, O_BITRATE, O_QUANTUM, O_LOCKSTEP, O_DURATION, O_END, O_REALTIME,
+        O_TRACE, O_STATS, O_MAXCL, O_FAULT, O_RECOVER, O_MAXREJ, O_SENDTO, O_CLBUF, O_GAP,
+        O_HELP
+    };
+    static const struct option longopts[] = {
+        {"socket", required_argument, NULL, O_SOCKET},
+        {"bitrate", required_argument, NULL, O_BITRATE},
+        {"quantum-us", required_argument, NULL, O_QUANTUM},
+        {"lockstep-clients", required_argument, NULL, O_LOCKSTEP},
+        {"duration", required_argument, NULL, O_DURATION},
+        {"end-ns", required_argument, NULL, O_END},
+        {"realtime", no_argument, NULL, O_REALTIME},
+        {"trace", required_argument, NULL, O_TRACE},
+        {"stats", required_argument, NULL, O_STATS},
+        {"max-clients", required_argument, NULL, O_MAXCL},
+        {"fault", required_argument, NULL, O_FAULT},
+        {"bus-off-recovery", no_argument, NULL, O_RECOVER},
+        {"max-rejects", required_argument, NULL, O_MAXREJ},
+        {"send-timeout-ms", required_argument, NULL, O_SENDTO},
+        {"client-buffer", required_argument, NULL, O_CLBUF},
+        {"gap-bits", required_argument, NULL, O_GAP},
+        {"quiet", no_argument, NULL, 'q'},
+        {"help", no_argument, NULL, O_HELP},
+        {0},
+    };
+    canbus_opts_t o = {
+        .bitrate = 1000000,
+        .quantum_ns = 5000000,
+        .end_ns = -1,
+        .max_clients = 64,
+        .max_rejects = 100,
+        .send_timeout_ns = 2000000000,
+        .client_buffer = 8u << 20,
+    };
+    int opt, status = 0;
+    int64_t v;
+    char err[160];
+    while ((opt = getopt_long(argc, argv, "q", longopts, NULL)) != -1) {
+        const char *bad = NULL;
+        switch (opt) {
+        case O_SOCKET: o.socket_path = optarg; break;
+        case O_BITRATE:
+            if (parse_i64(optarg, 1000, 10000000, &v))
+                bad = "--bitrate must be 1000..10000000";
+            o.bitrate = (uint32_t)v;
+            break;
+        case O_QUANTUM:
+            if (parse_i64(optarg, 1, 10000000, &v))
+                bad = "--quantum-us must be 1..10000000";
+            o.quantum_ns = v * 1000;
+            break;
+        case O_LOCKSTEP:
+            if (parse_i64(optarg, 0, CANBUS_WIRE_MAX_CLIENTS, &v))
+                bad = "--lockstep-clients must be 0..250";
+            o.lockstep_clients = (int)v;
+            break;
+        case O_DURATION: {
+            char *end;
+            double d = strtod(optarg, &end);
+            if (end == optarg || *end || !(d >= 0) || d > 9e9)
+                bad = "--duration must be a number of seconds";
+            else
+                o.end_ns = (int64_t)llround(d * 1e9);
+            break;
+        }
+        case O_END:
+            if (parse_i64(optarg, 0, INT64_MAX, &o.end_ns))
+                bad = "--end-ns must be >= 0";
+            break;
+        case O_REALTIME: o.realtime = true; break;
+        case O_TRACE: o.trace_path = optarg; break;
+        case O_STATS: o.stats_path = optarg; break;
+        case O_MAXCL:
+            if (parse_i64(optarg, 1, CANBUS_WIRE_MAX_CLIENTS, &v))
+                bad = "--max-clients must be 1..250";
+            o.max_clients = (int)v;
+            break;
+        case O_FAULT: {
+            canbus_cli_fault_t *f = realloc(o.faults, (o.n_faults + 1) * sizeof *f);
+            if (!f) {
+                bad = "out of memory";
+                break;
+            }
+            o.faults = f;
+            f = &o.faults[o.n_faults];
+            memset(f, 0, sizeof *f);
+            if (canbus_fault_parse(optarg, &f->fault, f->target_name, sizeof f->target_name,
+                                   err, sizeof err))
+                bad = err;
+            else
+                o.n_faults++;
+            break;
+        }
+        case O_RECOVER: o.recover = true; break;
+        case O_MAXREJ:
+            if (parse_i64(optarg, 0, 1000000000, &v))
+                bad = "--max-rejects must be >= 0";
+            o.max_rejects = (int)v;
+            break;
+        case O_SENDTO:
+            if (parse_i64(optarg, 1, 3600000, &v))
+                bad = "--send-timeout-ms must be 1..3600000";
+            o.send_timeout_ns = v * 1000000;
+            break;
+        case O_CLBUF:
+            if (parse_i64(optarg, 0, (int64_t)1 << 40, &v))
+                bad = "--client-buffer must be >= 0";
+            o.client_buffer = (size_t)v;
+            break;
+        case O_GAP:
+            if (parse_i64(optarg, 0, 1000, &v))
+                bad = "--gap-bits must be 0..1000";
+            o.gap_bits = (uint32_t)v;
+            break;
+        case 'q': o.quiet = true; break;
+        case O_HELP: usage(stdout); return 0;
+        default: usage(stderr); return EXIT_USAGE;
+        }
+        if (bad) {
+            fprintf(stderr, "ima-canbus: %s\n", bad);
+            free(o.faults);
+            return EXIT_USAGE;
+        }
+    }
+    if (!o.socket_path || optind != argc) {
+        usage(stderr);
+        free(o.faults);
+        return EXIT_USAGE;
+    }
+
+    /* Signals are blocked except inside ppoll(), so none is lost between checks. */
+    struct sigaction sa = {.sa_handler = on_signal};
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
+    sigset_t block;
+    sigemptyset(&block);
+    sigaddset(&block, SIGINT);
+    sigaddset(&block, SIGTERM);
+    sigprocmask(SIG_BLOCK, &block, NULL);
+
+    canbus_bus_t *b = calloc(1, sizeof *b);
+    if (!b) {
+        free(o.faults);
+        return 1;
+    }
+    int rc = canbus_bus_open(b, &o);
+    if (rc) {
+        fprintf(stderr, "ima-canbus: cannot open the bus on %s: %s\n", o.socket_path,
+                strerror(-rc));
+        free(b);
+        free(o.faults);
+        return 1;
+    }
+    rc = canbus_bus_run(b);
+    if (rc) {
+        fprintf(stderr, "ima-canbus: %s\n", strerror(-rc));
+        status = 1;
+    }
+    if (o.stats_path && (rc = canbus_bus_write_stats(b, o.stats_path))) {
+        fprintf(stderr, "ima-canbus: cannot write %s: %s\n", o.stats_path, strerror(-rc));
+        status = 1;
+    }
+    canbus_bus_close(b);
+    if (b->trace_error) {
+        fprintf(stderr, "ima-canbus: writing the trace failed\n");
+        status = 1;
+    }
+    free(b);
+    free(o.faults);
+    return status;
+}

@@ -1,0 +1,124 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The RPAS application's intra-node port messages: what the io partition, nav_fcs and (later)
+ * the mission manager exchange through sampling ports. Engineering units, doubles, each
+ * message stamped with the emulated time its data was taken (the end of the CAN frame it came
+ * from, or the time the producing partition computed it). Port names are in the module XML
+ * (config/nodes/). A message that stops coming makes its port INVALID after the port's
+ * refresh period: that is how a consumer sees a lost sensor, link or partition. */
+#ifndef RPAS_PORTS_H
+#define RPAS_PORTS_H
+
+#include <stdint.h>
+
+/* Flight-control modes, as in FCS_STATUS.FCS_MODE and PILOT_MODE.PIL_MODE (config/can/rpas.dbc). */
+enum rpas_mode {
+    RPAS_MODE_INIT = 0,
+    RPAS_MODE_DIRECT = 1,
+    RPAS_MODE_AUTOPILOT = 2,
+    RPAS_MODE_MISSION = 3,
+    RPAS_MODE_CONTINGENCY = 4,
+};
+enum rpas_lat_mode { RPAS_LAT_HDG = 0, RPAS_LAT_TRK = 1 };
+enum rpas_vert_mode { RPAS_VERT_ALT = 0, RPAS_VERT_VS = 1 };
+/* Why the FCS is not in the mode the pilot asked for (FCS_STATUS.FCS_FALLBACK). */
+enum rpas_fallback {
+    RPAS_FB_NONE = 0,
+    RPAS_FB_C2_LOST = 1,       /* pilot link lost: AUTOPILOT holding the current state */
+    RPAS_FB_MISSION_STALE = 2, /* MISSION/CONTINGENCY targets stale: AUTOPILOT holding */
+    RPAS_FB_NAV_INVALID = 3,   /* no usable navigation solution */
+    RPAS_FB_NO_TARGETS = 4,    /* AUTOPILOT asked before any target arrived: holding */
+};
+
+/* io -> nav_fcs: port GPS_IN (5 Hz) */
+typedef struct {
+    int64_t t_ns;
+    uint32_t seq; /* GPS_CNT: a frozen receiver repeats it */
+    uint32_t fix; /* 0 no fix, 2 2D, 3 3D */
+    uint32_t sats;
+    uint32_t pad;
+    double lat_deg, lon_deg, alt_ft, gs_kt, trk_deg;
+} rpas_gps_msg_t;
+
+/* io -> nav_fcs: port AHRS_IN (50 Hz; the three AHRS frames of one sample) */
+typedef struct {
+    int64_t t_ns;
+    uint32_t seq;
+    uint32_t status; /* bit0 valid, bit1 aligned */
+    double roll_deg, pitch_deg, hdg_deg; /* heading: true, 0..360 */
+    double p_dps, q_dps, r_dps;          /* body rates */
+    double ax_g, ay_g, az_g;             /* body specific force */
+} rpas_ahrs_msg_t;
+
+/* io -> nav_fcs: port AIR_IN (20 Hz) */
+typedef struct {
+    int64_t t_ns;
+    uint32_t seq;
+    uint32_t status; /* bit0 valid */
+    double ias_kt, alt_ft, vs_fpm; /* baro altitude */
+} rpas_air_msg_t;
+
+/* io -> nav_fcs: port PILOT_IN (C2 uplink; written only while uplink frames arrive) */
+typedef struct {
+    int64_t t_ns;
+    uint32_t mode;      /* enum rpas_mode the pilot asks for (0: none yet) */
+    uint32_t lat_mode;  /* enum rpas_lat_mode */
+    uint32_t vert_mode; /* enum rpas_vert_mode */
+    uint32_t have_targets; /* a PILOT_TARGETS frame has arrived */
+    double hdg_deg, alt_ft, ias_kt, vs_fpm;            /* autopilot targets */
+    double stk_pitch, stk_roll, stk_yaw, stk_thr;      /* -1..1 (thr 0..1); pitch + = pull */
+    int64_t t_stick_ns; /* time of the last PILOT_STICK frame (0: none) */
+} rpas_pilot_msg_t;
+
+/* io -> nav_fcs: port ACT_IN (smart actuators' measured positions) */
+typedef struct {
+    int64_t t_ns;
+    uint32_t state; /* 0 normal, 1 holding last command, 2 safe position */
+    uint32_t pad;
+    double elev, ail, rud, thr;
+} rpas_act_status_msg_t;
+
+/* nav_fcs -> io: port ACT_CMD_OUT (normalised; elevator + = nose down) */
+typedef struct {
+    int64_t t_ns;
+    uint32_t seq;
+    uint32_t pad;
+    double elev, ail, rud, thr;
+} rpas_act_cmd_msg_t;
+
+/* nav_fcs -> io: port FCS_STATUS_OUT */
+typedef struct {
+    int64_t t_ns;
+    uint32_t mode, req_mode, fallback; /* enum rpas_mode, rpas_mode, rpas_fallback */
+    uint32_t nav_flags;                /* bit0 GPS, bit1 AHRS, bit2 air data valid, bit3 DR */
+    uint32_t env_flags;                /* bit0 bank, bit1 pitch limited, bit2 over-, bit3 underspeed */
+    uint32_t lat_mode, vert_mode;
+    uint32_t pad;
+    double tgt_hdg_deg, tgt_alt_ft, tgt_ias_kt, tgt_vs_fpm;
+} rpas_fcs_status_msg_t;
+
+/* nav_fcs -> io (and later the mission manager): port NAV_OUT, the navigation solution */
+#define RPAS_NAV_GPS 0x1
+#define RPAS_NAV_AHRS 0x2
+#define RPAS_NAV_AIR 0x4
+#define RPAS_NAV_DR 0x8
+typedef struct {
+    int64_t t_ns;
+    uint32_t flags; /* RPAS_NAV_* */
+    uint32_t pad;
+    double lat_deg, lon_deg, alt_ft;
+    double ias_kt, gs_kt, trk_deg, hdg_deg, vs_fpm;
+    double roll_deg, pitch_deg;
+    double wind_n_kt, wind_e_kt; /* wind estimate: where the air moves to */
+} rpas_nav_msg_t;
+
+/* mission manager -> nav_fcs: port MISSION_IN (targets for MISSION / CONTINGENCY) */
+typedef struct {
+    int64_t t_ns;
+    uint32_t mode; /* RPAS_MODE_MISSION or RPAS_MODE_CONTINGENCY */
+    uint32_t lat_mode, vert_mode;
+    uint32_t pad;
+    double hdg_deg; /* heading or track, by lat_mode */
+    double alt_ft, ias_kt, vs_fpm;
+} rpas_mission_msg_t;
+
+#endif

@@ -1,0 +1,78 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Command line of the world process: python -m imaworld --bus SOCK --run-dir DIR ..."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ima.errors import ImaError
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(
+        prog="python -m imaworld",
+        description="The simulated world (JSBSim aircraft, sensors, smart actuators, wind, "
+                    "C2 link, remote pilot station) as a LOCKSTEP client of the CAN bus.")
+    ap.add_argument("--bus", required=True, help="the bus socket (ima-canbus --socket)")
+    ap.add_argument("--run-dir", required=True, help="where truth.jsonl, world.jsonl and "
+                    "world.json go")
+    ap.add_argument("--seed", type=int, default=0, help="seed of every random process")
+    ap.add_argument("--pilot", required=True, help="remote pilot station script (YAML)")
+    ap.add_argument("--turbulence", choices=["none", "light", "moderate"], default=None,
+                    help="MIL-F-8785C turbulence (JSBSim Milspec; default: the script's, "
+                    "else none)")
+    ap.add_argument("--wind", type=float, default=None, metavar="KT",
+                    help="steady wind speed in kt (default: the script's, else calm)")
+    ap.add_argument("--wind-from", type=float, default=None, metavar="DEG",
+                    help="direction the wind blows from, degrees true (default 270)")
+    ap.add_argument("--terrain-ft", type=float, default=500.0,
+                    help="elevation of the flat terrain (ft MSL, default 500)")
+    ap.add_argument("--status", action="store_true",
+                    help="print one JSON progress line per emulated second on stdout")
+    ap.add_argument("--name", default="world", help="client name on the bus")
+    ap.add_argument("--debug", action="store_true", help="show tracebacks")
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return run(args)
+    except ImaError as e:
+        if args.debug:
+            raise
+        print(f"imaworld: {e}", file=sys.stderr)
+        return e.exit_code
+
+
+def run(args) -> int:
+    from ima.canbus import proto
+    from ima.canbus.client import BusClient
+
+    from . import pilot
+    from .fdm import quiet_stdout
+    from .world import Options, World
+
+    script = pilot.load(args.pilot)  # bad scripts fail before we join the bus
+    if args.wind is not None and args.wind < 0:
+        raise ImaError("--wind must not be negative", exit_code=2)
+    status_out = quiet_stdout()  # JSBSim prints to stdout; only --status lines may go there
+    opts = Options(seed=args.seed, turbulence=args.turbulence or script.turbulence or "none",
+                   wind_kt=args.wind, wind_from_deg=args.wind_from,
+                   terrain_ft=args.terrain_ft, status=args.status)
+    if script.start["altitude_ft"] - opts.terrain_ft < 200:
+        raise ImaError(f"{args.pilot}: start.altitude_ft {script.start['altitude_ft']} is less "
+                       f"than 200 ft above the terrain ({opts.terrain_ft} ft)", exit_code=2)
+    # Trim before joining: a start the aircraft cannot fly never holds up the bus.
+    world = World(None, script, args.run_dir, opts,
+                  status_out=status_out if args.status else None)
+    world.bus = bus = BusClient(args.bus, args.name, proto.ROLE_CAN | proto.ROLE_LOCKSTEP)
+    try:
+        return world.run()
+    finally:
+        bus.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,104 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Every tunable parameter of the world in one place: sensors, actuators, atmosphere, limits."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+NS = 1_000_000_000
+KT_TO_FPS = 1.6878098571011957
+FT_TO_M = 0.3048
+G_FPS2 = 32.174049
+
+
+@dataclass(frozen=True)
+class GpsParams:
+    period_ms: int = 200  # GPS_POS + GPS_VEL at 5 Hz
+    bias_tau_s: float = 300.0  # first-order Gauss-Markov position bias
+    bias_sigma_h_m: float = 2.0  # per horizontal axis (north, east)
+    bias_sigma_v_m: float = 4.0
+    noise_h_m: float = 1.5  # white noise per horizontal axis
+    noise_v_m: float = 3.0
+    noise_vel_mps: float = 0.1  # white noise per ground-velocity axis (north, east)
+    sats: int = 9
+    # What a LOST receiver sends: "no_fix" = both frames, fix 0, zero data, counter runs on;
+    # "silent" = nothing at all.
+    lost_mode: str = "no_fix"
+
+
+@dataclass(frozen=True)
+class AhrsParams:
+    period_ms: int = 20  # AHRS_ATT, AHRS_RATE, AHRS_ACCEL at 50 Hz
+    noise_att_deg: float = 0.1  # roll, pitch
+    noise_hdg_deg: float = 0.3
+    bias_tau_s: float = 120.0
+    bias_sigma_att_deg: float = 0.1
+    bias_sigma_hdg_deg: float = 0.5
+    noise_rate_dps: float = 0.05
+    bias_sigma_rate_dps: float = 0.02
+    noise_accel_g: float = 0.01
+    bias_sigma_accel_g: float = 0.002
+
+
+@dataclass(frozen=True)
+class AdcParams:
+    period_ms: int = 50  # AIR_DATA at 20 Hz
+    noise_ias_kt: float = 0.3
+    bias_sigma_ias_kt: float = 0.3
+    noise_alt_ft: float = 2.0
+    bias_sigma_alt_ft: float = 3.0
+    bias_tau_s: float = 300.0
+    noise_vs_fpm: float = 30.0
+
+
+@dataclass(frozen=True)
+class ActuatorParams:
+    status_period_ms: int = 50  # ACT_STATUS at 20 Hz
+    surface_rate: float = 2.0  # normalised units per second (full travel -1..1 in 1 s)
+    throttle_rate: float = 0.5
+    surface_limit: float = 1.0  # |position| limit of elevator, aileron, rudder
+    throttle_min: float = 0.0
+    throttle_max: float = 1.0
+    stale_s: float = 0.1  # no command for this long: commands have stopped (2 cycles)
+    hold_s: float = 0.5  # then hold the last command this long ...
+    safe_throttle: float = 0.0  # ... then go to the safe position (surfaces 0)
+    startup_hold_s: float = 2.0  # before the first command: hold the trimmed positions this long
+
+
+@dataclass(frozen=True)
+class StationParams:
+    mode_period_ms: int = 100  # PILOT_MODE + PILOT_TARGETS at 10 Hz
+    stick_period_ms: int = 50  # PILOT_STICK at 20 Hz
+    downlink_fresh_s: float = 1.0  # an FCS channel's status counts as current this long
+
+
+@dataclass(frozen=True)
+class AtmosphereParams:
+    # MIL-F-8785C turbulence via JSBSim's Milspec model: (severity, wind at 20 ft AGL in kt).
+    turbulence: dict = field(default_factory=lambda: {
+        "none": (0, 0.0), "light": (3, 15.0), "moderate": (4, 30.0)})
+
+
+@dataclass(frozen=True)
+class LimitParams:
+    max_roll_deg: float = 90.0  # beyond: loss of control, counted as a crash
+    max_cas_kt: float = 200.0  # c172p Vne is 163 KCAS; past 200 the model is meaningless
+    max_load_g: float = 8.0
+
+
+@dataclass(frozen=True)
+class WorldParams:
+    aircraft: str = "c172p"
+    physics_hz: int = 120
+    truth_period_ms: int = 100  # truth.jsonl at 10 Hz
+    mixture: float = 0.87
+    gps: GpsParams = field(default_factory=GpsParams)
+    ahrs: AhrsParams = field(default_factory=AhrsParams)
+    adc: AdcParams = field(default_factory=AdcParams)
+    actuators: ActuatorParams = field(default_factory=ActuatorParams)
+    station: StationParams = field(default_factory=StationParams)
+    atmosphere: AtmosphereParams = field(default_factory=AtmosphereParams)
+    limits: LimitParams = field(default_factory=LimitParams)
+
+
+DEFAULT = WorldParams()

@@ -1,0 +1,167 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Sensor models (GPS, AHRS, air data) turning the true state into CAN frames with errors."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import zlib
+
+import numpy as np
+
+from ima.canbus.codec import MESSAGES
+
+from .config import FT_TO_M, AdcParams, AhrsParams, GpsParams
+
+R_EARTH_M = 6_378_137.0
+MPS_TO_KT = 1.0 / 0.514444
+DEG = 180.0 / math.pi
+
+_GPS_POS = MESSAGES["GPS_POS"]
+_GPS_VEL = MESSAGES["GPS_VEL"]
+_AHRS_ATT = MESSAGES["AHRS_ATT"]
+_AHRS_RATE = MESSAGES["AHRS_RATE"]
+_AHRS_ACCEL = MESSAGES["AHRS_ACCEL"]
+_AIR_DATA = MESSAGES["AIR_DATA"]
+
+
+def normal_stream(seed: int, name: str):
+    """A function returning standard normal draws, one per call, from a numpy PCG64 generator
+    seeded by (seed, name): each sensor has its own stream, so adding draws to one sensor does
+    not change another's. Draws come in blocks (far cheaper per value than random.gauss)."""
+    gen = np.random.Generator(np.random.PCG64(np.random.SeedSequence(
+        [seed & 0xFFFFFFFFFFFFFFFF, zlib.crc32(name.encode())])))
+
+    def blocks():
+        while True:
+            yield gen.standard_normal(4096).tolist()
+
+    return itertools.chain.from_iterable(blocks()).__next__
+
+
+class GaussMarkov:
+    """First-order Gauss-Markov process sampled every dt: stationary, std `sigma`, time constant
+    `tau`. Starts from a draw of its stationary distribution."""
+
+    __slots__ = ("a", "q", "x", "n")
+
+    def __init__(self, n, sigma: float, tau_s: float, dt_s: float) -> None:
+        self.a = math.exp(-dt_s / tau_s) if tau_s > 0 else 0.0
+        self.q = sigma * math.sqrt(1.0 - self.a * self.a)
+        self.n = n
+        self.x = sigma * n()
+
+    def step(self) -> float:
+        self.x = self.a * self.x + self.q * self.n()
+        return self.x
+
+
+class Gps:
+    """GPS receiver: GPS_POS + GPS_VEL at each sample; state ok / lost / frozen."""
+
+    def __init__(self, p: GpsParams, seed: int) -> None:
+        self.p = p
+        self.n = rng = normal_stream(seed, "gps")
+        dt = p.period_ms / 1000.0
+        self.bn = GaussMarkov(rng, p.bias_sigma_h_m, p.bias_tau_s, dt)
+        self.be = GaussMarkov(rng, p.bias_sigma_h_m, p.bias_tau_s, dt)
+        self.bd = GaussMarkov(rng, p.bias_sigma_v_m, p.bias_tau_s, dt)
+        self.state = "ok"
+        self.cnt = 0
+        self.last: list[tuple[int, bytes]] = []
+
+    def sample(self, lat: float, lon: float, alt_ft: float, vn_fps: float,
+               ve_fps: float) -> list[tuple[int, bytes]]:
+        p, n = self.p, self.n
+        bn, be, bd = self.bn.step(), self.be.step(), self.bd.step()  # biases run in every state
+        if self.state == "frozen":
+            return self.last  # same data, same counter
+        self.cnt = (self.cnt + 1) & 0xFF
+        if self.state == "lost":
+            if p.lost_mode == "silent":
+                return []
+            out = [(_GPS_POS.frame_id, _GPS_POS.encode(0.0, 0.0)),
+                   (_GPS_VEL.frame_id, _GPS_VEL.encode(0, 0.0, 0.0, 0, 2, self.cnt))]
+            self.last = out
+            return out
+        dn = bn + p.noise_h_m * n()
+        de = be + p.noise_h_m * n()
+        du = bd + p.noise_v_m * n()
+        mlat = lat + dn / R_EARTH_M * DEG
+        mlon = lon + de / (R_EARTH_M * math.cos(lat / DEG)) * DEG
+        if mlon >= 180.0:
+            mlon -= 360.0
+        elif mlon < -180.0:
+            mlon += 360.0
+        vn = vn_fps * FT_TO_M + p.noise_vel_mps * n()
+        ve = ve_fps * FT_TO_M + p.noise_vel_mps * n()
+        gs = math.hypot(vn, ve) * MPS_TO_KT
+        trk = math.atan2(ve, vn) * DEG % 360.0
+        if trk >= 359.995:
+            trk = 0.0
+        out = [(_GPS_POS.frame_id, _GPS_POS.encode(mlat, mlon)),
+               (_GPS_VEL.frame_id, _GPS_VEL.encode(alt_ft + du / FT_TO_M, gs, trk, 3, p.sats,
+                                                   self.cnt))]
+        self.last = out
+        return out
+
+
+class Ahrs:
+    """Attitude and heading reference: AHRS_ATT, AHRS_RATE, AHRS_ACCEL at each sample."""
+
+    def __init__(self, p: AhrsParams, seed: int) -> None:
+        self.p = p
+        self.n = rng = normal_stream(seed, "ahrs")
+        dt = p.period_ms / 1000.0
+        gm = GaussMarkov
+        self.b_att = [gm(rng, p.bias_sigma_att_deg, p.bias_tau_s, dt) for _ in range(2)]
+        self.b_hdg = gm(rng, p.bias_sigma_hdg_deg, p.bias_tau_s, dt)
+        self.b_rate = [gm(rng, p.bias_sigma_rate_dps, p.bias_tau_s, dt) for _ in range(3)]
+        self.b_acc = [gm(rng, p.bias_sigma_accel_g, p.bias_tau_s, dt) for _ in range(3)]
+        self.cnt = 0
+
+    def sample(self, phi: float, theta: float, psi: float, p_: float, q: float, r: float,
+               ax: float, ay: float, az: float) -> list[tuple[int, bytes]]:
+        """Angles in degrees, rates in rad/s, specific force in g (body axes, z down)."""
+        P, n = self.p, self.n
+        ba, br, bc = self.b_att, self.b_rate, self.b_acc
+        self.cnt = c = (self.cnt + 1) & 0xFF
+        roll = phi + ba[0].step() + P.noise_att_deg * n()
+        if roll > 180.0:
+            roll -= 360.0
+        elif roll < -180.0:
+            roll += 360.0
+        pitch = theta + ba[1].step() + P.noise_att_deg * n()
+        hdg = (psi + self.b_hdg.step() + P.noise_hdg_deg * n()) % 360.0
+        if hdg >= 359.995:
+            hdg = 0.0
+        nr, na = P.noise_rate_dps, P.noise_accel_g
+        return [
+            (_AHRS_ATT.frame_id, _AHRS_ATT.encode(roll, pitch, hdg, 3, c)),
+            (_AHRS_RATE.frame_id, _AHRS_RATE.encode(
+                p_ * DEG + br[0].step() + nr * n(), q * DEG + br[1].step() + nr * n(),
+                r * DEG + br[2].step() + nr * n(), 3, c)),
+            (_AHRS_ACCEL.frame_id, _AHRS_ACCEL.encode(
+                ax + bc[0].step() + na * n(), ay + bc[1].step() + na * n(),
+                az + bc[2].step() + na * n(), 3, c)),
+        ]
+
+
+class AirData:
+    """Air data computer: AIR_DATA (calibrated airspeed, baro altitude, vertical speed)."""
+
+    def __init__(self, p: AdcParams, seed: int) -> None:
+        self.p = p
+        self.n = rng = normal_stream(seed, "adc")
+        dt = p.period_ms / 1000.0
+        self.b_ias = GaussMarkov(rng, p.bias_sigma_ias_kt, p.bias_tau_s, dt)
+        self.b_alt = GaussMarkov(rng, p.bias_sigma_alt_ft, p.bias_tau_s, dt)
+        self.cnt = 0
+
+    def sample(self, cas_kt: float, palt_ft: float, hdot_fps: float) -> list[tuple[int, bytes]]:
+        P, n = self.p, self.n
+        self.cnt = c = (self.cnt + 1) & 0xF
+        ias = max(0.0, cas_kt + self.b_ias.step() + P.noise_ias_kt * n())
+        alt = palt_ft + self.b_alt.step() + P.noise_alt_ft * n()
+        vs = hdot_fps * 60.0 + P.noise_vs_fpm * n()
+        return [(_AIR_DATA.frame_id, _AIR_DATA.encode(ias, alt, vs, 1, c))]

@@ -1,0 +1,387 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The world process: physics, sensors, actuators, C2 link and pilot station, in bus lockstep."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from ima.canbus import proto
+from ima.canbus.codec import BY_ID, MESSAGES, choices
+
+from .actuators import CHANNELS, Actuators
+from .config import DEFAULT, NS, WorldParams
+from .fdm import Aircraft
+from .pilot import LAT_MODE_CODES, MODE_CODES, VERT_MODE_CODES, PilotScript
+from .sensors import AirData, Ahrs, Gps
+
+INF = 1 << 62
+
+_PILOT_MODE = MESSAGES["PILOT_MODE"]
+_PILOT_TARGETS = MESSAGES["PILOT_TARGETS"]
+_PILOT_STICK = MESSAGES["PILOT_STICK"]
+_ACT_STATUS = MESSAGES["ACT_STATUS"]
+_ACT_CMD = {MESSAGES[f"ACT_CMD_{c}"].frame_id: (i, MESSAGES[f"ACT_CMD_{c}"].decode)
+            for i, c in enumerate(CHANNELS)}
+_FCS_STATUS = {MESSAGES[f"FCS_STATUS_{c}"].frame_id: (i, MESSAGES[f"FCS_STATUS_{c}"].decode)
+               for i, c in enumerate(CHANNELS)}
+FCS_MODES = choices("FCS_STATUS_A", "FCS_MODE_A")
+FCS_FALLBACKS = choices("FCS_STATUS_A", "FCS_FALLBACK_A")
+
+
+class Crash(Exception):
+    pass
+
+
+@dataclass
+class Options:
+    seed: int = 0
+    turbulence: str = "none"
+    wind_kt: float | None = None  # None: the script's wind, else calm
+    wind_from_deg: float | None = None
+    terrain_ft: float = 500.0
+    status: bool = False
+
+
+def _r(x: float, n: int) -> float | None:
+    """Round for the output files (fixed precision keeps runs byte-identical and small)."""
+    if x != x or x in (math.inf, -math.inf):
+        return None
+    v = round(x, n)
+    return 0.0 if v == 0 else v  # no "-0.0"
+
+
+class World:
+    """Everything outside the avionics. `bus` is a BusClient-like object (wait_tick, send,
+    done, stop); the world is a LOCKSTEP client and runs until the bus stops or it crashes."""
+
+    def __init__(self, bus, script: PilotScript, run_dir: str | Path, opts: Options,
+                 params: WorldParams = DEFAULT, status_out=None) -> None:
+        self.bus = bus
+        self.script = script
+        self.p = params
+        self.opts = opts
+        self.run_dir = Path(run_dir)
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        self.status_out = status_out
+        seed = opts.seed
+        if opts.wind_kt is not None:
+            wind = (opts.wind_kt, 270.0 if opts.wind_from_deg is None else opts.wind_from_deg)
+        elif script.wind:
+            wind = (script.wind.get("speed_kt", 0.0), script.wind.get("from_deg", 270.0))
+        else:
+            wind = (0.0, 270.0)
+        self.wind = wind
+        self.ac = Aircraft(params, script.start, seed, opts.terrain_ft, wind)
+        self.trim = self.ac.trim()
+        turb = opts.turbulence
+        if turb not in params.atmosphere.turbulence:
+            raise ValueError(f"unknown turbulence {turb!r}")
+        self.ac.set_turbulence(*params.atmosphere.turbulence[turb])
+        tr = self.trim
+        self.act = Actuators(params.actuators, (tr["elev"], tr["ail"], tr["rud"], tr["thr"]))
+        self.ac.set_controls(*self.act.pos)
+        self.gps = Gps(params.gps, seed)
+        self.ahrs = Ahrs(params.ahrs, seed)
+        self.adc = AirData(params.adc, seed)
+        # station
+        self.station = dict(script.initial)
+        self.pil_cnt = 0
+        self.stk_cnt = 0
+        self.fcs_status: list[tuple[int, int, int] | None] = [None, None, None]  # (t, mode, fb)
+        self.fcs_last: tuple[int, int] | None = None
+        # bookkeeping
+        self.hz = params.physics_hz
+        self.dt = 1.0 / self.hz
+        self.n = 0  # physics steps done: the state is at t_n = n * NS // hz
+        self.next_step_t = NS // self.hz
+        self.t_now = 0
+        self.sent: dict[str, int] = {}
+        self.received: dict[str, int] = {}
+        self.crash: tuple[int, str] | None = None
+        self.stop_reason: str | None = None
+        self.t_end = 0
+        self.events_f = open(self.run_dir / "world.jsonl", "w")
+        self.truth_f = open(self.run_dir / "truth.jsonl", "w")
+        self.last_truth: dict | None = None
+        self._act_trans_done = 0
+        self._evt_idx = 0
+        self._evt_times = [round(e["t"] * NS) for e in script.events]
+        self.event("world", "start", aircraft=params.aircraft, seed=seed,
+                   turbulence=turb, wind_kt=_r(wind[0], 3), wind_from_deg=_r(wind[1], 3),
+                   terrain_ft=_r(opts.terrain_ft, 3),
+                   trim={k: _r(v, 6) for k, v in self.trim.items()},
+                   start=script.start)
+        self._tasks = self._make_tasks()
+
+    # -- output --------------------------------------------------------------------------
+    def event(self, src: str, kind: str, t_ns: int | None = None, **fields) -> None:
+        rec = {"t_ns": self.t_now if t_ns is None else t_ns, "node": "world", "src": src,
+               "kind": kind, **fields}
+        self.events_f.write(json.dumps(rec, separators=(",", ":")) + "\n")
+
+    def _send(self, t_ns: int, frames) -> None:
+        send, sent = self.bus.send, self.sent
+        for fid, data in frames:
+            send(fid, data, t_ns)
+            name = BY_ID[fid].name
+            sent[name] = sent.get(name, 0) + 1
+
+    def fcs_mode(self) -> tuple[str | None, str | None]:
+        """What the station shows: the lowest FCS channel heard recently, else the last heard."""
+        fresh = round(self.p.station.downlink_fresh_s * NS)
+        for st in self.fcs_status:
+            if st is not None and self.t_now - st[0] <= fresh:
+                return FCS_MODES.get(st[1], str(st[1])), FCS_FALLBACKS.get(st[2], str(st[2]))
+        if self.fcs_last is None:
+            return None, None
+        m, fb = self.fcs_last
+        return FCS_MODES.get(m, str(m)), FCS_FALLBACKS.get(fb, str(fb))
+
+    def truth(self) -> dict:
+        g = self.ac.get
+        pos = self.act.pos
+        vn, ve = g["vn"](), g["ve"]()
+        mode, fb = self.fcs_mode()
+        return {
+            "t_ns": self.t_now,
+            "lat_deg": _r(g["lat"](), 7), "lon_deg": _r(g["lon"](), 7),
+            "alt_ft": _r(g["alt"](), 2), "agl_ft": _r(g["agl"](), 2),
+            "airspeed_kt": _r(g["cas"](), 3), "tas_kt": _r(g["tas"](), 3),
+            "gs_kt": _r(math.hypot(vn, ve) / 1.6878098571011957, 3),
+            "heading_deg": _r(g["psi"]() % 360.0, 3),
+            "track_deg": _r(math.degrees(math.atan2(ve, vn)) % 360.0, 3),
+            "roll_deg": _r(g["phi"](), 3), "pitch_deg": _r(g["theta"](), 3),
+            "vs_fpm": _r(g["hdot"]() * 60.0, 1),
+            "elev": _r(pos[0], 4), "ail": _r(pos[1], 4), "rud": _r(pos[2], 4),
+            "thr": _r(pos[3], 4),
+            "fcs_mode": mode, "fcs_fallback": fb,
+            "c2_link": self.station["c2_link"], "gps": self.gps.state,
+            "wind_n_kt": _r(g["wind_n"]() / 1.6878098571011957, 3),
+            "wind_e_kt": _r(g["wind_e"]() / 1.6878098571011957, 3),
+        }
+
+    # -- periodic work -------------------------------------------------------------------
+    def _make_tasks(self) -> list[list]:
+        p = self.p
+        ms = 1_000_000
+        tasks = [
+            [self._next_event_t(), 0, self._pilot_events],
+            [0, p.gps.period_ms * ms, self._gps],
+            [0, p.ahrs.period_ms * ms, self._ahrs],
+            [0, p.adc.period_ms * ms, self._adc],
+            [0, p.actuators.status_period_ms * ms, self._act_status],
+            [0, p.station.mode_period_ms * ms, self._uplink_mode],
+            [0, p.station.stick_period_ms * ms, self._uplink_stick],
+            [0, p.truth_period_ms * ms, self._truth],
+        ]
+        if self.status_out is not None:
+            tasks.append([0, NS, self._status])
+        return tasks
+
+    def _next_event_t(self) -> int:
+        i = self._evt_idx
+        return self._evt_times[i] if i < len(self._evt_times) else INF
+
+    def _pilot_events(self, t: int) -> None:
+        evs = self.script.events
+        while self._evt_idx < len(evs) and self._evt_times[self._evt_idx] <= t:
+            e = evs[self._evt_idx]
+            self._evt_idx += 1
+            old = self.station
+            self.station = PilotScript.apply(old, e)
+            fields = {k: v for k, v in e.items() if k != "t"}
+            self.event("pilot", "pilot_event", **fields)
+            if self.station["c2_link"] != old["c2_link"]:
+                self.event("c2", "c2_link", state=self.station["c2_link"])
+            if self.station["gps"] != old["gps"]:
+                self.gps.state = self.station["gps"]
+                self.event("gps", "sensor_state", sensor="gps", state=self.gps.state)
+            if e.get("wind") is not None:
+                w = e["wind"]
+                self.wind = (w.get("speed_kt", self.wind[0]), w.get("from_deg", self.wind[1]))
+                self.ac.set_wind(*self.wind)
+                self.event("world", "wind", speed_kt=self.wind[0], from_deg=self.wind[1])
+
+    def _gps(self, t: int) -> None:
+        g = self.ac.get
+        self._send(t, self.gps.sample(g["lat"](), g["lon"](), g["alt"](), g["vn"](), g["ve"]()))
+
+    def _ahrs(self, t: int) -> None:
+        g = self.ac.get
+        self._send(t, self.ahrs.sample(g["phi"](), g["theta"](), g["psi"](), g["p"](), g["q"](),
+                                       g["r"](), g["ax"](), g["ay"](), g["az"]()))
+
+    def _adc(self, t: int) -> None:
+        g = self.ac.get
+        self._send(t, self.adc.sample(g["cas"](), g["palt"](), g["hdot"]()))
+
+    def _act_status(self, t: int) -> None:
+        pos = self.act.pos
+        self._send(t, [(_ACT_STATUS.frame_id,
+                        _ACT_STATUS.encode(pos[0], pos[1], pos[2], pos[3], self.act.state))])
+
+    def _uplink_mode(self, t: int) -> None:
+        st = self.station
+        if st["c2_link"] != "up":
+            return
+        self.pil_cnt = (self.pil_cnt + 1) & 0xFF
+        self._send(t, [
+            (_PILOT_MODE.frame_id, _PILOT_MODE.encode(
+                MODE_CODES[st["mode"]], LAT_MODE_CODES[st["lat_mode"]],
+                VERT_MODE_CODES[st["vert_mode"]], self.pil_cnt)),
+            (_PILOT_TARGETS.frame_id, _PILOT_TARGETS.encode(
+                st["heading_deg"] % 360.0, st["altitude_ft"], st["airspeed_kt"], st["vs_fpm"])),
+        ])
+
+    def _uplink_stick(self, t: int) -> None:
+        st = self.station
+        if st["c2_link"] != "up":
+            return
+        s = st["stick"]
+        thr = s["throttle"] if s["throttle"] is not None else self.trim["thr"]
+        self.stk_cnt = (self.stk_cnt + 1) & 0xF
+        self._send(t, [(_PILOT_STICK.frame_id, _PILOT_STICK.encode(
+            s["pitch"], s["roll"], s["yaw"], thr, self.stk_cnt))])
+
+    def _truth(self, t: int) -> None:
+        rec = self.truth()
+        self.last_truth = rec
+        self.truth_f.write(json.dumps(rec, separators=(",", ":")) + "\n")
+
+    def _status(self, t: int) -> None:
+        g = self.ac.get
+        line = {"t_s": t / NS, "alt_ft": _r(g["alt"](), 1), "airspeed_kt": _r(g["cas"](), 1),
+                "heading_deg": _r(g["psi"]() % 360.0, 1), "mode": self.fcs_mode()[0]}
+        self.status_out.write(json.dumps(line) + "\n")
+
+    # -- frames in -----------------------------------------------------------------------
+    def _frames(self, frames) -> None:
+        rcv = self.received
+        link_up = self.station["c2_link"] == "up"
+        for f in frames:
+            fid = f.id
+            m = BY_ID.get(fid)
+            name = m.name if m is not None else f"0x{fid:08x}"
+            rcv[name] = rcv.get(name, 0) + 1
+            a = _ACT_CMD.get(fid)
+            if a is not None:
+                e, ai, ru, th, _cnt = a[1](f.data)
+                self.act.command(a[0], f.t_ns, (e, ai, ru, th))
+                continue
+            s = _FCS_STATUS.get(fid)
+            if s is not None and link_up:
+                v = s[1](f.data)
+                self.fcs_status[s[0]] = (f.t_ns, v[0], v[2])
+                self.fcs_last = (v[0], v[2])
+
+    # -- physics -------------------------------------------------------------------------
+    def advance(self, t: int) -> None:
+        """Run every physics step ending at or before t (the state is then at the last t_n <= t)."""
+        if self.next_step_t > t:
+            return
+        ac, act, g = self.ac, self.act, self.ac.get
+        run, set_controls, dt, hz = ac.run, ac.set_controls, self.dt, self.hz
+        lim = self.p.limits
+        agl, phi, cas, nz = g["agl"], g["phi"], g["cas"], g["nz"]
+        n = self.n
+        while self.next_step_t <= t:
+            t_n = n * NS // hz
+            pos = act.step(t_n, dt)
+            set_controls(pos[0], pos[1], pos[2], pos[3])
+            run()
+            n += 1
+            self.next_step_t = (n + 1) * NS // hz
+            self.n = n
+            self.t_now = n * NS // hz
+            a, r = agl(), phi()
+            if not a > 0.0 or not -lim.max_roll_deg <= r <= lim.max_roll_deg:
+                if a != a or r != r:
+                    self._crash("state is not a number")
+                self._crash("ground contact" if a <= 0.0 else f"roll {r:.1f} deg")
+            c, z = cas(), nz()
+            if not c <= lim.max_cas_kt or not abs(z) <= lim.max_load_g:
+                self._crash(f"airspeed {c:.1f} kt" if not c <= lim.max_cas_kt
+                            else f"load factor {z:.1f} g")
+        if len(act.transitions) > self._act_trans_done:
+            for tt, state, ch in act.transitions[self._act_trans_done:]:
+                self.event("actuators", "actuator_state", t_ns=tt, state=state, channel=ch)
+            self._act_trans_done = len(act.transitions)
+
+    def _crash(self, reason: str) -> None:
+        self.crash = (self.t_now, reason)
+        raise Crash(reason)
+
+    # -- main loop -----------------------------------------------------------------------
+    def run(self) -> int:
+        bus = self.bus
+        tasks = self._tasks
+        next_due = min(tk[0] for tk in tasks)
+        wall0 = time.perf_counter()
+        try:
+            while True:
+                tick = bus.wait_tick()
+                if tick is None:
+                    self.stop_reason = proto.STOP_REASONS.get(bus.stopped, str(bus.stopped))
+                    break
+                T, t_until, frames = tick
+                if frames:
+                    self._frames(frames)
+                while next_due < t_until:
+                    s = next_due
+                    self.advance(s)
+                    self.t_now = s
+                    for tk in tasks:
+                        if tk[0] == s:
+                            tk[2](s)
+                            tk[0] = self._next_event_t() if tk[1] == 0 else s + tk[1]
+                    next_due = min(tk[0] for tk in tasks)
+                self.advance(t_until)
+                self.t_end = t_until
+                bus.done(t_until)
+        except Crash as c:
+            t, reason = self.crash
+            self.event("world", "crash", t_ns=t, reason=reason)
+            print(f"imaworld: crash at t={t / NS:.3f} s: {reason}; stopping the bus",
+                  file=sys.stderr)
+            self.t_end = t
+            self.stop_reason = f"crash: {c}"
+            bus.stop()
+        self.t_now = max(self.t_now, self.t_end)
+        self.finish(time.perf_counter() - wall0)
+        return 0
+
+    def finish(self, wall_s: float) -> None:
+        if len(self.act.transitions) > self._act_trans_done:
+            for tt, state, ch in self.act.transitions[self._act_trans_done:]:
+                self.event("actuators", "actuator_state", t_ns=tt, state=state, channel=ch)
+        self.event("world", "stop", t_ns=self.t_end, reason=self.stop_reason)
+        self.events_f.close()
+        self.truth_f.close()
+        final = self.truth()
+        final["t_ns"] = self.t_now
+        summary = {
+            "aircraft": self.p.aircraft,
+            "seed": self.opts.seed,
+            "pilot": str(self.script.path),
+            "turbulence": self.opts.turbulence,
+            "wind_kt": _r(self.wind[0], 3), "wind_from_deg": _r(self.wind[1], 3),
+            "terrain_ft": _r(self.opts.terrain_ft, 3),
+            "trim": {k: _r(v, 6) for k, v in self.trim.items()},
+            "crashed": self.crash is not None,
+            "crash_t_s": None if self.crash is None else self.crash[0] / NS,
+            "reason": self.crash[1] if self.crash else self.stop_reason,
+            "t_end_ns": self.t_end,
+            "steps": self.n,
+            "final": final,
+            "frames_sent": dict(sorted(self.sent.items())),
+            "frames_received": dict(sorted(self.received.items())),
+        }
+        (self.run_dir / "world.json").write_text(json.dumps(summary, indent=1) + "\n")
+        emu = self.t_end / NS
+        print(f"imaworld: {emu:.1f} s emulated, {self.n} steps, {wall_s:.2f} s wall"
+              + (f" ({emu / wall_s:.0f}x real time)" if wall_s > 0 else ""), file=sys.stderr)

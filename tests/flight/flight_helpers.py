@@ -1,0 +1,55 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Helpers of the flight tests: a node module with a stand-in mission manager, failure dumps."""
+
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+PILOTS = ROOT / "sim" / "pilots"
+
+
+def mission_node_module(dest: Path, feed_args: str) -> Path:
+    """The flight node plus a stand-in mission manager (partition mission_feed) writing
+    MISSION targets to nav_fcs in the free part of the major frame."""
+    ns = "urn:ima-testbed:arinc653-linux:1"
+    ET.register_namespace("ima", ns)
+    tree = ET.parse(ROOT / "config" / "nodes" / "rpas_node.xml")
+    root = tree.getroot()
+    last_part = [i for i, el in enumerate(root) if el.tag == "Partition"][-1]
+    part = ET.Element("Partition", PartitionIdentifier="3", PartitionName="mission_feed",
+                      Criticality="LEVEL_C", SystemPartition="false", EntryPoint="main")
+    ET.SubElement(part, "Sampling_Port", Name="MISSION_OUT", MaxMessageSize="56",
+                  Direction="SOURCE", RefreshRateSeconds="0.5")
+    ET.SubElement(part, "Process", Name="feed", StackSize="65536")
+    ET.SubElement(part, f"{{{ns}}}Linux", Executable="mission_feed", Arguments=feed_args)
+    root.insert(last_part + 1, part)
+    mem_at = [i for i, el in enumerate(root) if el.tag == "Partition_Memory"][-1]
+    mem = ET.Element("Partition_Memory", PartitionIdentifier="3", PartitionName="mission_feed")
+    ET.SubElement(mem, "Memory_Requirements", Type="DATA", SizeBytes="0x2000000",
+                  Access="READ_WRITE")
+    root.insert(mem_at + 1, mem)
+    sched = root.find("Module_Schedule")
+    ps = ET.SubElement(sched, "Partition_Schedule", PartitionIdentifier="3",
+                       PartitionName="mission_feed", PeriodSeconds="0.05",
+                       PeriodDurationSeconds="0.005")
+    ET.SubElement(ps, "Window_Schedule", WindowIdentifier="4", WindowStartSeconds="0.03",
+                  WindowDurationSeconds="0.005", PartitionPeriodStart="true")
+    table = root.find("Connection_Table")
+    ch = ET.SubElement(table, "Channel", ChannelIdentifier="9", ChannelName="mission")
+    src = ET.SubElement(ch, "Source")
+    ET.SubElement(src, "Standard_Partition", PartitionIdentifier="3",
+                  PartitionName="mission_feed", PortName="MISSION_OUT")
+    dst = ET.SubElement(ch, "Destination")
+    ET.SubElement(dst, "Standard_Partition", PartitionIdentifier="2", PartitionName="nav_fcs",
+                  PortName="MISSION_IN")
+    tree.write(dest, encoding="UTF-8", xml_declaration=True)
+    return dest
+
+
+def dump(f) -> str:
+    """What a failing assertion shows: the summary without the long lists."""
+    s = {k: v for k, v in f.summary.items() if k not in ("hm_event_list",)}
+    return json.dumps(s, indent=1)

@@ -11,15 +11,26 @@ import textwrap
 import pytest
 
 from ima import cli
-from ima.commands import bench, demo, run, test
+from ima.commands import bench, demo, fly, run, test
 from ima.errors import ImaError
 
 
 @pytest.mark.parametrize(
     ("argv", "func", "expected"),
     [
-        (["demo"], demo.run, {"frames": 200}),
-        (["demo", "--frames", "20"], demo.run, {"frames": 20}),
+        (["demo"], demo.run, {"duration": 600.0, "seed": 1, "turbulence": "light", "wind": 10.0}),
+        (["demo", "--duration", "60", "--seed", "3"], demo.run, {"duration": 60.0, "seed": 3}),
+        (
+            ["fly", "--duration", "600", "--seed", "7", "--json"],
+            fly.run,
+            {"duration": 600.0, "seed": 7, "json": True, "realtime": False, "pilot": None},
+        ),
+        (
+            ["fly", "--turbulence", "none", "--wind", "0", "--realtime"],
+            fly.run,
+            {"turbulence": "none", "wind": 0.0, "realtime": True},
+        ),
+        (["bench", "flight", "--json"], bench.run, {"target": "flight", "json": True}),
         (
             ["run", "m.xml"],
             run.run,
@@ -82,7 +93,11 @@ def test_documented_commands_parse(argv, func, expected):
     "argv",
     [
         [],
-        ["fly"],
+        ["fly", "--duration", "0"],
+        ["fly", "--duration", "nan"],
+        ["fly", "--turbulence", "heavy"],
+        ["fly", "--wind", "-3"],
+        ["fly", "--seed", "x"],
         ["run"],
         ["run", "m.xml", "--frames", "0"],
         ["run", "m.xml", "--frames", "ten"],

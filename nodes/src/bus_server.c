@@ -697,7 +697,9 @@ static int out_reserve(canbus_bus_t *b, size_t n)
     return 0;
 }
 
-/* Quantum start: frames that ended at or before t to CAN clients, then TICK to members. */
+/* Quantum start: frames that ended at or before t to CAN clients, then TICK to members. The
+ * clients that get no TICK are served first: a node's io partition must hold its frames
+ * before its SKE, granted the quantum, can run the window that reads them. */
 static int deliver(canbus_bus_t *b, int64_t t, bool tick)
 {
     canbus_wire_t *w = &b->wire;
@@ -706,35 +708,45 @@ static int deliver(canbus_bus_t *b, int64_t t, bool tick)
         last++;
     if (out_reserve(b, last - first + 1))
         return -ENOMEM;
-    for (size_t i = 0; i < b->n_live; i++) {
-        canbus_client_t *c = b->live[i];
-        if (c->gone || c->index < 0)
-            continue;
-        if (c->member_next && tick) {
-            c->member = true;
-            c->member_next = false;
-        }
-        size_t n = 0;
-        if (c->roles & CANBUS_ROLE_CAN) {
-            bool own = c->roles & CANBUS_ROLE_OWN;
-            for (size_t k = first; k < last; k++) {
-                const canbus_wire_ev_t *e = &w->ev[k];
-                if (e->kind == CANBUS_EV_TX && e->client == c->index && !own)
-                    continue;
-                if (ev_rec(e, &b->out[n])) {
-                    if (e->kind == CANBUS_EV_TX)
-                        c->rx++;
-                    n++;
-                }
+    if (tick)
+        for (size_t i = 0; i < b->n_live; i++) {
+            canbus_client_t *c = b->live[i];
+            if (!c->gone && c->index >= 0 && c->member_next) {
+                c->member = true;
+                c->member_next = false;
             }
         }
-        if (c->member && tick) {
-            c->done = false;
-            b->out[n++] = (struct canbus_rec){.type = CANBUS_MSG_TICK, .t_ns = b->t_next, .aux = t};
-        }
-        for (size_t k = 0; k < n && !c->gone; k += CANBUS_MAX_RECS) {
-            size_t m = n - k < CANBUS_MAX_RECS ? n - k : CANBUS_MAX_RECS;
-            client_send(b, c, &b->out[k], m * sizeof *b->out);
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t i = 0; i < b->n_live; i++) {
+            canbus_client_t *c = b->live[i];
+            if (c->gone || c->index < 0)
+                continue;
+            bool ticked = c->member && tick;
+            if (ticked != (pass == 1))
+                continue;
+            size_t n = 0;
+            if (c->roles & CANBUS_ROLE_CAN) {
+                bool own = c->roles & CANBUS_ROLE_OWN;
+                for (size_t k = first; k < last; k++) {
+                    const canbus_wire_ev_t *e = &w->ev[k];
+                    if (e->kind == CANBUS_EV_TX && e->client == c->index && !own)
+                        continue;
+                    if (ev_rec(e, &b->out[n])) {
+                        if (e->kind == CANBUS_EV_TX)
+                            c->rx++;
+                        n++;
+                    }
+                }
+            }
+            if (ticked) {
+                c->done = false;
+                b->out[n++] = (struct canbus_rec){.type = CANBUS_MSG_TICK, .t_ns = b->t_next,
+                                                  .aux = t};
+            }
+            for (size_t k = 0; k < n && !c->gone; k += CANBUS_MAX_RECS) {
+                size_t m = n - k < CANBUS_MAX_RECS ? n - k : CANBUS_MAX_RECS;
+                client_send(b, c, &b->out[k], m * sizeof *b->out);
+            }
         }
     }
     w->ev_head = last;

@@ -23,7 +23,7 @@ def test_shipped_scripts_load(name):
 
 def test_default_script_segments():
     s = pilot.load(PILOTS / "default.yaml")
-    assert s.settle_s == 60
+    assert s.settle_s == 120
     segs = s.autopilot_segments(600)
     assert [(a, b) for a, b, _ in segs] == [(0, 200), (200, 380), (380, 600)]
     assert [(t["heading_deg"], t["altitude_ft"]) for _, _, t in segs] == \

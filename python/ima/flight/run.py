@@ -26,7 +26,7 @@ from pathlib import Path
 from ima import paths
 from ima.errors import ImaError
 
-DEFAULT_QUANTUM_US = 5000
+DEFAULT_QUANTUM_US = 10000
 NODE_MODULE = "rpas_node.xml"
 TURBULENCE = ("none", "light", "moderate")
 # A child that outlives the end of the run by this much (wall seconds) is killed.
@@ -167,6 +167,32 @@ def _wait_for_socket(path: Path, bus: subprocess.Popen, log: Path, timeout: floa
         time.sleep(0.005)
 
 
+def _bus_connections(sock: Path) -> int:
+    """Connections made to the bus on `sock` (their bus side appears in /proc/net/unix under
+    its path as soon as the client has connected, accepted or not)."""
+    name = os.fsencode(sock)
+    try:
+        with open("/proc/net/unix", "rb") as f:
+            lines = f.read().splitlines()[1:]
+    except OSError:
+        return 0
+    # the listening socket has flag __SO_ACCEPTCON (00010000); accepted ones do not
+    return sum(1 for ln in lines if ln.endswith(b" " + name) and ln.split()[3] != b"00010000")
+
+
+def _wait_joined(sock: Path, count: int, procs: _Procs, timeout: float = 10.0) -> None:
+    """Waits until `count` clients are connected, so clients join in a fixed order (the bus
+    numbers them by arrival, and the numbers are in its trace)."""
+    deadline = time.monotonic() + timeout
+    while _bus_connections(sock) < count:
+        for name, proc in procs.procs.items():
+            if proc.poll() is not None:
+                raise ImaError(f"{name} exited ({proc.returncode}) before joining the bus")
+        if time.monotonic() > deadline:
+            raise ImaError(f"fewer than {count} clients joined the bus within {timeout:.0f} s")
+        time.sleep(0.002)
+
+
 def _tail(path: Path, lines: int = 5) -> str:
     try:
         text = path.read_text(errors="replace").strip().splitlines()
@@ -256,9 +282,10 @@ def fly(opts: FlightOptions, on_status: Callable[[dict], None] | None = None) ->
         bus = procs.start("canbus", bus_cmd, run_dir / "canbus.log")
         _wait_for_socket(sock, bus, run_dir / "canbus.log")
         base_env = dict(os.environ, IMA_CANBUS=str(sock), **opts.extra_env)
-        for name, cmd in node_cmds:
+        for k, (name, cmd) in enumerate(node_cmds, start=1):
             env = dict(base_env, IMA_NODE_INDEX=name.removeprefix("node"))
             procs.start(name, cmd, run_dir / f"{name}.log", env=env)
+            _wait_joined(sock, k, procs)
         world = procs.start("world", world_cmd, run_dir / "world.log", env=base_env,
                             stdout=subprocess.PIPE)
         assert world.stdout is not None

@@ -90,7 +90,7 @@ def fly_and_summarise(opts: flight.FlightOptions, json_out: bool) -> int:
 
         result = flight.fly(opts, on_status=on_status)
     summary = flight_summary.summarise(result.run_dir, pilot, opts.duration_s, result.wall_s,
-                                       nodes=opts.nodes)
+                                       nodes=opts.nodes, plot=True)
     summary["returncodes"] = result.returncodes
     failed = {k: v for k, v in result.returncodes.items() if v not in (0, None)}
     if json_out:
@@ -116,7 +116,8 @@ def print_summary(s: dict, console) -> None:
     state = "[red]CRASHED[/]" if s["crashed"] else "[green]flying[/]"
     console.print(f"Flown {s['flown_s']:.0f} s emulated in {s.get('wall_s', 0):.1f} s wall "
                   f"(×{s.get('speedup') or 0:.0f}); aircraft {state}")
-    t = Table(title="Tracking over the autopilot hold segments (truth)", show_edge=False)
+    console.print("Tracking error, judged on the truth over the hold segments:")
+    t = Table(show_edge=False)
     for col in ("", "max |error|", "RMS"):
         t.add_column(col, justify="right")
     t.add_row("altitude", _fmt(s["alt_err_ft_max"], "ft"), _fmt(s["alt_err_ft_rms"], "ft"))
@@ -134,6 +135,8 @@ def print_summary(s: dict, console) -> None:
                   f"{(load or 0) * 100:.1f} % (max 1 s: {(s.get('bus_load_max_1s') or 0) * 100:.1f} %), "
                   f"error frames {s.get('can_error_frames') or 0}")
     console.print(f"Health-monitor events: {s['hm_events']}")
+    if s.get("plot"):
+        console.print(f"Plot: {s['plot']}")
     for ev in s["hm_event_list"][:5]:
         console.print(f"  {ev['t_ns'] / 1e9:9.3f} s {ev['node']}/{ev.get('partition')}: "
                       f"{ev.get('error')} → {ev.get('action')}", markup=False)

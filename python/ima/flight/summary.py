@@ -144,8 +144,9 @@ def hm_events(node_trace: Path) -> list[dict]:
 
 
 def summarise(run_dir: Path, pilot: Path, duration_s: float, wall_s: float | None = None,
-              nodes: int = 1) -> dict[str, Any]:
-    """The flight's summary (also written to RUN_DIR/summary.json)."""
+              nodes: int = 1, plot: bool = False) -> dict[str, Any]:
+    """The flight's summary (also written to RUN_DIR/summary.json); `plot` also draws
+    RUN_DIR/flight.png."""
     truth_path = run_dir / "truth.jsonl"
     truth = list(read_jsonl(truth_path))
     world = _read_json(run_dir / "world.json")
@@ -174,5 +175,10 @@ def summarise(run_dir: Path, pilot: Path, duration_s: float, wall_s: float | Non
     if wall_s:
         summary["wall_s"] = round(wall_s, 2)
         summary["speedup"] = round(summary["flown_s"] / wall_s, 1) if wall_s > 0 else None
+    if plot and truth:
+        from ima.flight.plot import plot_flight
+
+        summary["plot"] = str(plot_flight(truth, segments, run_dir / "flight.png",
+                                          f"{pilot.name}, {run_dir.name}"))
     (run_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     return summary

@@ -89,3 +89,21 @@ def test_stale_mission_targets_fall_back_to_autopilot(mission):
     assert all(abs((r["heading_deg"] - fb[3] + 180) % 360 - 180) < 3 for r in held)
     assert all(abs(r["alt_ft"] - fb[4]) < 30 for r in held)
     assert all(s[1] == "AUTOPILOT" for s in status if s[0] > 42.5)
+
+
+@pytest.fixture(scope="module")
+def gps_loss(flights):
+    return flights.fly("gps_loss", duration_s=150, seed=5, turbulence="light",
+                       pilot=PILOTS / "gps_loss.yaml")
+
+
+def test_gps_frozen_then_lost_dead_reckoning_keeps_the_hold(gps_loss):
+    nav = [(t, int(d["FCS_NAV_FLAGS_A"])) for t, d in gps_loss.can_frames("FCS_STATUS_A")]
+    # bit0 GPS valid, bit3 dead reckoning (config/can/rpas.dbc)
+    assert all(f & 0x1 and not f & 0x8 for t, f in nav if 5 < t < 30)
+    assert all(f & 0x8 and not f & 0x1 for t, f in nav if 35 < t < 120)  # frozen is caught too
+    assert all(f & 0x1 and not f & 0x8 for t, f in nav if 125 < t)
+    held = gps_loss.truth_between(30, 150)
+    assert all(abs(r["alt_ft"] - 3000) < 60 for r in held)
+    assert all(abs((r["heading_deg"] - 90 + 180) % 360 - 180) < 12 for r in held)
+    assert not gps_loss.summary["crashed"]

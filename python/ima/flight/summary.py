@@ -157,6 +157,10 @@ def summarise(run_dir: Path, pilot: Path, duration_s: float, wall_s: float | Non
     if summary["crashed"]:
         summary["crash"] = {"t_s": world.get("crash_t_s"), "reason": world.get("reason")}
     summary["flown_s"] = round(truth[-1]["t_ns"] / 1e9, 2) if truth else 0.0
+    # a run cut short (Ctrl-C, crash) is judged on what it flew
+    segments = [HoldSegment(g.t0_s, min(g.t1_s, summary["flown_s"]), g.heading_deg,
+                            g.altitude_ft, g.airspeed_kt)
+                for g in segments if g.t0_s < summary["flown_s"]]
     summary.update(tracking_errors(truth, segments))
     summary["hold_segments"] = [
         {"t0_s": s.t0_s, "t1_s": s.t1_s, "heading_deg": s.heading_deg,

@@ -17,26 +17,9 @@
 #include <time.h>
 #include <unistd.h>
 
-static int failures;
+#include "canbus_test.h"
+
 static const char *bus_path;
-
-#define CHECK(cond)                                                                           \
-    do {                                                                                      \
-        if (!(cond)) {                                                                        \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);          \
-            failures++;                                                                       \
-        }                                                                                     \
-    } while (0)
-
-#define CHECK_EQ(a, e)                                                                        \
-    do {                                                                                      \
-        intmax_t a_ = (intmax_t)(a), e_ = (intmax_t)(e);                                      \
-        if (a_ != e_) {                                                                       \
-            fprintf(stderr, "%s:%d: %s == %s: got %jd, expected %jd\n", __FILE__, __LINE__,   \
-                    #a, #e, a_, e_);                                                          \
-            failures++;                                                                       \
-        }                                                                                     \
-    } while (0)
 
 #define REQUIRE(cond)                                                                         \
     do {                                                                                      \

@@ -20,7 +20,7 @@ import tempfile
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 from ima import paths
@@ -47,7 +47,6 @@ class FlightOptions:
     node_module: Path | None = None  # default: config/nodes/rpas_node.xml
     quantum_us: int = DEFAULT_QUANTUM_US
     nodes: int = 1
-    extra_env: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass
@@ -281,7 +280,7 @@ def fly(opts: FlightOptions, on_status: Callable[[dict], None] | None = None) ->
             previous[s] = signal.signal(s, on_signal)
         bus = procs.start("canbus", bus_cmd, run_dir / "canbus.log")
         _wait_for_socket(sock, bus, run_dir / "canbus.log")
-        base_env = dict(os.environ, IMA_CANBUS=str(sock), **opts.extra_env)
+        base_env = dict(os.environ, IMA_CANBUS=str(sock))
         for k, (name, cmd) in enumerate(node_cmds, start=1):
             env = dict(base_env, IMA_NODE_INDEX=name.removeprefix("node"))
             procs.start(name, cmd, run_dir / f"{name}.log", env=env)

@@ -19,6 +19,7 @@ def test_two_lockstep_clients_exchange_frames(fakebus, sock_path):
 
     def sender():
         c = BusClient(sock_path, "tx", LOCK)
+        got["tx_index"] = c.client  # the two threads join in either order
         while (tick := c.wait_tick()) is not None:
             if tick.t_from == 0:
                 c.send(0x100, b"\x01\x02\x03", 1_000_000)
@@ -52,7 +53,7 @@ def test_two_lockstep_clients_exchange_frames(fakebus, sock_path):
     assert (f1.start_ns, f1.t_ns) == (1_000_000, 1_000_000 + bits1 * 1000)
     assert f2.start_ns == f1.t_ns  # waited for the wire
     assert t1 == t2 == 5_000_000  # delivered at the start of the next quantum
-    assert f1.extended and f1.src == 0
+    assert f1.extended and f1.src == got["tx_index"]
 
 
 def test_stop_from_a_client_ends_the_run(fakebus, sock_path):

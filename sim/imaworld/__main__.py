@@ -8,6 +8,8 @@ import sys
 
 from ima.errors import ImaError
 
+from .config import DEFAULT
+
 
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(
@@ -28,6 +30,18 @@ def build_parser() -> argparse.ArgumentParser:
                     help="direction the wind blows from, degrees true (default 270)")
     ap.add_argument("--terrain-ft", type=float, default=500.0,
                     help="elevation of the flat terrain (ft MSL, default 500)")
+    ap.add_argument("--channels", type=int, choices=(1, 2, 3), default=None,
+                    help="flight-control replicas commanding the actuators on ACT_CMD_A..; "
+                    "given, the actuators vote over them (default: one, not voted: the "
+                    "lowest live channel is used)")
+    ap.add_argument("--vote-threshold", default=None, metavar="ELEV,AIL,RUD,THR",
+                    help="miscompare thresholds of the vote per axis, normalised (default "
+                    "0.1,0.1,0.1,0.1)")
+    ap.add_argument("--vote-persist", type=int, default=None, metavar="N",
+                    help="consecutive bad votes before a channel is voted out (default 3)")
+    ap.add_argument("--vote-offset", type=float, default=None, metavar="S",
+                    help="when the actuators vote in each 50 ms major frame, in seconds from "
+                    "its start (default 0.045)")
     ap.add_argument("--status", action="store_true",
                     help="print one JSON progress line per emulated second on stdout")
     ap.add_argument("--name", default="world", help="client name on the bus")
@@ -46,6 +60,36 @@ def main(argv: list[str] | None = None) -> int:
         return e.exit_code
 
 
+def vote_options(args) -> dict:
+    """The voting options as World Options fields; ImaError (exit 2) when one is bad."""
+    out: dict = {"channels": args.channels}
+    given = [f"--{k.replace('_', '-')}" for k in ("vote_threshold", "vote_persist", "vote_offset")
+             if getattr(args, k) is not None]
+    if given and args.channels is None:
+        raise ImaError(f"{', '.join(given)}: only with --channels (without it nothing is "
+                       "voted)", exit_code=2)
+    if args.vote_threshold is not None:
+        try:
+            thr = tuple(float(x) for x in args.vote_threshold.split(","))
+        except ValueError:
+            thr = ()
+        if len(thr) != 4 or not all(x >= 0 for x in thr):  # also refuses NaN
+            raise ImaError(f"--vote-threshold {args.vote_threshold!r}: expected four numbers "
+                           ">= 0, elev,ail,rud,thr", exit_code=2)
+        out["vote_threshold"] = thr
+    if args.vote_persist is not None:
+        if args.vote_persist < 1:
+            raise ImaError("--vote-persist must be at least 1", exit_code=2)
+        out["vote_persist"] = args.vote_persist
+    if args.vote_offset is not None:
+        period_s = DEFAULT.voting.period_ms / 1000
+        if not 0 <= args.vote_offset < period_s:  # also refuses NaN
+            raise ImaError(f"--vote-offset {args.vote_offset:g}: must be within the "
+                           f"{period_s:g} s major frame, 0 <= S < {period_s:g}", exit_code=2)
+        out["vote_offset_s"] = args.vote_offset
+    return out
+
+
 def run(args) -> int:
     from ima.canbus import proto
     from ima.canbus.client import BusClient
@@ -57,10 +101,11 @@ def run(args) -> int:
     script = pilot.load(args.pilot)  # bad scripts fail before we join the bus
     if args.wind is not None and args.wind < 0:
         raise ImaError("--wind must not be negative", exit_code=2)
+    voting = vote_options(args)
     status_out = quiet_stdout()  # JSBSim prints to stdout; only --status lines may go there
     opts = Options(seed=args.seed, turbulence=args.turbulence or script.turbulence or "none",
                    wind_kt=args.wind, wind_from_deg=args.wind_from,
-                   terrain_ft=args.terrain_ft, status=args.status)
+                   terrain_ft=args.terrain_ft, status=args.status, **voting)
     if script.start["altitude_ft"] - opts.terrain_ft < 200:
         raise ImaError(f"{args.pilot}: start.altitude_ft {script.start['altitude_ft']} is less "
                        f"than 200 ft above the terrain ({opts.terrain_ft} ft)", exit_code=2)

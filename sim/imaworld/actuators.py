@@ -1,10 +1,14 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Smart actuators: command selection over the redundancy channels, rate and position limits,
-hold-last and safe position when commands stop."""
+"""Smart actuators: command selection over the redundancy channels (simplex, or the C voter's
+mid-value select with monitoring), rate and position limits, hold-last and safe position when
+commands stop."""
 
 from __future__ import annotations
 
+from collections import deque
+
 from .config import NS, ActuatorParams
+from .voter import Voter, mask_letters
 
 NORMAL, HOLD_LAST, SAFE = 0, 1, 2
 STATE_NAMES = ("NORMAL", "HOLD_LAST", "SAFE")
@@ -17,7 +21,13 @@ class CommandSelector:
     The actuators call `update()` for every ACT_CMD_x frame and `select()` once per physics
     step; `select()` returns (command, channel label) or (None, None) when no channel is fresh.
     A command is (elevator, aileron, rudder, throttle) in the DBC's sign convention.
+    `newest_t()` is when the command path was last alive (hold-last counts from there),
+    `commanded()` whether a command has ever been selectable. A selector whose
+    `latches_safe` is true makes the safe position final once the actuators reach it after
+    having been commanded.
     """
+
+    latches_safe = False
 
     def __init__(self, n_channels: int = 3) -> None:
         self.last_t = [-1] * n_channels
@@ -29,6 +39,9 @@ class CommandSelector:
 
     def newest_t(self) -> int:
         return max(self.last_t)
+
+    def commanded(self) -> bool:
+        return self.newest_t() >= 0
 
     def select(self, now_ns: int, stale_ns: int) -> tuple[tuple | None, str | None]:
         raise NotImplementedError
@@ -44,6 +57,99 @@ class LowestLiveChannel(CommandSelector):
         return None, None
 
 
+class VotingSelector(CommandSelector):
+    """The smart actuators' voter (DESIGN.md §3): the C voter (nodes/include/voter/voter.h,
+    through imaworld.voter) over channels A.. of the n configured, dim 4 (elev, ail, rud, thr).
+
+    Voting frames come once per major frame, at `offset_ns` into it (k * period + offset). A
+    channel is present in a vote when an ACT_CMD frame of it ended since the previous vote and
+    by the vote (its newest such command is voted; frames that end later wait for the next
+    vote). Voting starts with the first vote that has a command in it: until then the startup
+    rule of the actuators holds, and no channel is counted absent. Between votes the last voted
+    command is used; a vote without a candidate (SAFE, DISAGREE) gives (None, None), so the
+    actuators hold the last voted command for stale + hold after the last vote that had one,
+    then go to the safe position and stay there (`latches_safe`).
+
+    `events` collects (t_ns, kind, fields) for the world's trace: "vote" when the status or
+    the set of used channels changes, "voted_out" when a channel is declared failed.
+    Frames of channels >= n are ignored.
+    """
+
+    latches_safe = True
+
+    def __init__(self, n_channels: int, thresholds=(0.1, 0.1, 0.1, 0.1), persist: int = 3,
+                 offset_ns: int = 45_000_000, period_ns: int = 50_000_000,
+                 safe=(0.0, 0.0, 0.0, 0.0)) -> None:
+        if not 0 <= offset_ns < period_ns:
+            raise ValueError(f"vote offset {offset_ns} ns is not within the {period_ns} ns frame")
+        super().__init__(n_channels)
+        self.n = n_channels
+        self.voter = Voter(n_channels, 4, thresholds, persist, safe)
+        self.period_ns = period_ns
+        self.next_vote_t = offset_ns
+        self._pending: list[deque] = [deque() for _ in range(n_channels)]
+        self.started = False
+        self.cmd: tuple | None = None
+        self.label: str | None = None
+        self.last_voted_t = -1  # the last vote that had a candidate
+        self.status: str | None = None  # of the last vote
+        self.used = ""  # letters of the channels the last vote used
+        self.votes = 0
+        self.events: list[tuple[int, str, dict]] = []
+        self.voted_out: list[dict] = []  # {"t_ns", "node", "channel", "reason"}
+
+    def update(self, channel: int, t_ns: int, cmd: tuple) -> None:
+        if channel >= self.n:
+            return
+        super().update(channel, t_ns, cmd)
+        self._pending[channel].append((t_ns, cmd))
+
+    def newest_t(self) -> int:
+        return self.last_voted_t
+
+    def select(self, now_ns: int, stale_ns: int) -> tuple[tuple | None, str | None]:
+        while self.next_vote_t <= now_ns:
+            self._vote(self.next_vote_t)
+            self.next_vote_t += self.period_ns
+        return self.cmd, self.label
+
+    def _vote(self, tv: int) -> None:
+        values: list[tuple | None] = [None] * self.n
+        for c, q in enumerate(self._pending):
+            while q and q[0][0] <= tv:
+                values[c] = q.popleft()[1]
+        if not self.started:
+            if all(v is None for v in values):
+                return
+            self.started = True
+        r = self.voter.step(values)
+        self.votes += 1
+        used = mask_letters(r.used)
+        if r.used:
+            self.cmd, self.label, self.last_voted_t = r.value, used, tv
+        else:
+            self.cmd = self.label = None
+        if r.status != self.status or used != self.used:
+            self.status, self.used = r.status, used
+            self.events.append((tv, "vote", {"status": r.status, "used": list(used)}))
+        for c in range(self.n):
+            if r.newly_failed >> c & 1:
+                rec = {"node": f"node{c + 1}", "channel": CHANNELS[c],
+                       "reason": self.voter.reason(c)}
+                self.voted_out.append({"t_ns": tv, **rec})
+                self.events.append((tv, "voted_out", rec))
+
+    def summary(self) -> dict:
+        """For world.json: the final vote and who was voted out."""
+        return {"status": self.status, "used": list(self.used), "votes": self.votes,
+                "disagree": self.voter.disagree, "voted_out": list(self.voted_out)}
+
+
+def safe_position(p: ActuatorParams) -> tuple[float, float, float, float]:
+    """Surfaces 0, throttle at its safe setting within its limits."""
+    return (0.0, 0.0, 0.0, min(max(p.safe_throttle, p.throttle_min), p.throttle_max))
+
+
 class Actuators:
     """Four smart actuators sharing one command path. Positions are in the DBC convention:
     elevator + = nose down, aileron + = roll right, rudder + = yaw right, throttle 0..1."""
@@ -57,36 +163,44 @@ class Actuators:
         self.last_cmd: tuple = tuple(trim)  # what hold-last holds
         self.state = HOLD_LAST  # holding the trimmed positions until the first command
         self.channel: str | None = None
-        self.ever_commanded = False
+        self.safe_latched = False
         self.stale_ns = round(p.stale_s * NS)
         self.hold_ns = round(p.hold_s * NS)
         self.startup_ns = round(p.startup_hold_s * NS)
         lim = p.surface_limit
         self.lo = (-lim, -lim, -lim, p.throttle_min)
         self.hi = (lim, lim, lim, p.throttle_max)
-        self.safe = (0.0, 0.0, 0.0, min(max(p.safe_throttle, p.throttle_min), p.throttle_max))
+        self.safe = safe_position(p)
         self.transitions: list[tuple[int, str, str | None]] = []  # (t_ns, state, channel)
 
     def command(self, channel: int, t_ns: int, cmd: tuple) -> None:
         """An ACT_CMD frame of redundancy channel `channel` (0 = A) that ended at t_ns."""
         self.selector.update(channel, t_ns, cmd)
-        self.ever_commanded = True
+
+    @property
+    def ever_commanded(self) -> bool:
+        return self.selector.commanded()
 
     def _target(self, now: int) -> tuple:
-        cmd, ch = self.selector.select(now, self.stale_ns)
-        if cmd is not None:
+        sel = self.selector
+        cmd, ch = sel.select(now, self.stale_ns)  # every step: a voter keeps voting
+        if self.safe_latched:
+            ch = None
+            state, target = SAFE, self.safe
+        elif cmd is not None:
             state, target = NORMAL, cmd
             self.last_cmd = cmd
-        elif not self.ever_commanded:
+        elif not sel.commanded():
             ch = None
             state, target = (HOLD_LAST, self.trim) if now <= self.startup_ns else (SAFE, self.safe)
         else:
             ch = None
-            silent = now - self.selector.newest_t()
+            silent = now - sel.newest_t()
             if silent <= self.stale_ns + self.hold_ns:
                 state, target = HOLD_LAST, self.last_cmd
             else:
                 state, target = SAFE, self.safe
+                self.safe_latched = sel.latches_safe
         if state != self.state or ch != self.channel:
             if state != self.state or ch is not None:
                 self.transitions.append((now, STATE_NAMES[state], ch))

@@ -66,6 +66,16 @@ class ActuatorParams:
 
 
 @dataclass(frozen=True)
+class VotingParams:
+    """The smart actuators' voter, used when the world is told how many channels there are."""
+    period_ms: int = 50  # one voting frame per major frame ...
+    offset_s: float = 0.045  # ... at this offset into it: votes at k * period + offset
+    thresholds: tuple = (0.1, 0.1, 0.1, 0.1)  # |x - voted| above this is a miscompare (elev,
+    # ail, rud, thr; normalised units)
+    persist: int = 3  # consecutive bad votes (miscompare or absent) before a channel is out
+
+
+@dataclass(frozen=True)
 class StationParams:
     mode_period_ms: int = 100  # PILOT_MODE + PILOT_TARGETS at 10 Hz
     stick_period_ms: int = 50  # PILOT_STICK at 20 Hz
@@ -96,6 +106,7 @@ class WorldParams:
     ahrs: AhrsParams = field(default_factory=AhrsParams)
     adc: AdcParams = field(default_factory=AdcParams)
     actuators: ActuatorParams = field(default_factory=ActuatorParams)
+    voting: VotingParams = field(default_factory=VotingParams)
     station: StationParams = field(default_factory=StationParams)
     atmosphere: AtmosphereParams = field(default_factory=AtmosphereParams)
     limits: LimitParams = field(default_factory=LimitParams)

@@ -7,14 +7,14 @@ import json
 import math
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ima.canbus import proto
 from ima.canbus.codec import BY_ID, MESSAGES, choices
 
-from .actuators import CHANNELS, Actuators
-from .config import DEFAULT, NS, WorldParams
+from .actuators import CHANNELS, Actuators, LowestLiveChannel, VotingSelector, safe_position
+from .config import DEFAULT, NS, VotingParams, WorldParams
 from .fdm import Aircraft
 from .pilot import LAT_MODE_CODES, MODE_CODES, VERT_MODE_CODES, PilotScript
 from .sensors import AirData, Ahrs, Gps
@@ -45,6 +45,13 @@ class Options:
     wind_from_deg: float | None = None
     terrain_ft: float = 500.0
     status: bool = False
+    # Flight-control replicas commanding the actuators (ACT_CMD_A..), 1..3: the actuators
+    # vote over them (with these overrides of WorldParams.voting). None: not told, so one
+    # replica, simplex: the lowest live channel is used, nothing is voted.
+    channels: int | None = None
+    vote_threshold: tuple | None = None  # (elev, ail, rud, thr)
+    vote_persist: int | None = None
+    vote_offset_s: float | None = None
 
 
 def _r(x: float, n: int) -> float | None:
@@ -83,7 +90,9 @@ class World:
             raise ValueError(f"unknown turbulence {turb!r}")
         self.ac.set_turbulence(*params.atmosphere.turbulence[turb])
         tr = self.trim
-        self.act = Actuators(params.actuators, (tr["elev"], tr["ail"], tr["rud"], tr["thr"]))
+        self.voting = self._voting_params(params.voting, opts)
+        self.act = Actuators(params.actuators, (tr["elev"], tr["ail"], tr["rud"], tr["thr"]),
+                             self._selector(opts.channels, self.voting, params))
         self.ac.set_controls(*self.act.pos)
         self.gps = Gps(params.gps, seed)
         self.ahrs = Ahrs(params.ahrs, seed)
@@ -109,6 +118,7 @@ class World:
         self.truth_f = open(self.run_dir / "truth.jsonl", "w")
         self.last_truth: dict | None = None
         self._act_trans_done = 0
+        self._vote_ev_done = 0
         self._evt_idx = 0
         self._evt_times = [round(e["t"] * NS) for e in script.events]
         self.event("world", "start", aircraft=params.aircraft, seed=seed,
@@ -117,6 +127,26 @@ class World:
                    trim={k: _r(v, 6) for k, v in self.trim.items()},
                    start=script.start)
         self._tasks = self._make_tasks()
+
+    @staticmethod
+    def _voting_params(vp: VotingParams, opts: Options) -> VotingParams:
+        if opts.vote_threshold is not None:
+            vp = replace(vp, thresholds=tuple(float(x) for x in opts.vote_threshold))
+        if opts.vote_persist is not None:
+            vp = replace(vp, persist=opts.vote_persist)
+        if opts.vote_offset_s is not None:
+            vp = replace(vp, offset_s=opts.vote_offset_s)
+        return vp
+
+    @staticmethod
+    def _selector(channels: int | None, vp: VotingParams, params: WorldParams):
+        if channels is None:
+            return LowestLiveChannel()
+        if channels not in (1, 2, 3):
+            raise ValueError(f"channels must be 1, 2 or 3, not {channels!r}")
+        period = vp.period_ms * 1_000_000
+        return VotingSelector(channels, vp.thresholds, vp.persist, round(vp.offset_s * NS),
+                              period, safe_position(params.actuators))
 
     # -- output --------------------------------------------------------------------------
     def event(self, src: str, kind: str, t_ns: int | None = None, **fields) -> None:
@@ -307,10 +337,24 @@ class World:
             if not c <= lim.max_cas_kt or not abs(z) <= lim.max_load_g:
                 self._crash(f"airspeed {c:.1f} kt" if not c <= lim.max_cas_kt
                             else f"load factor {z:.1f} g")
-        if len(act.transitions) > self._act_trans_done:
-            for tt, state, ch in act.transitions[self._act_trans_done:]:
-                self.event("actuators", "actuator_state", t_ns=tt, state=state, channel=ch)
-            self._act_trans_done = len(act.transitions)
+        self._log_actuators()
+
+    def _log_actuators(self) -> None:
+        """Actuator state changes and the voter's events, in time order (a vote before the
+        state change it causes)."""
+        act = self.act
+        votes = getattr(act.selector, "events", ())
+        if len(act.transitions) == self._act_trans_done and len(votes) == self._vote_ev_done:
+            return
+        out = [(t, 0, i, kind, f) for i, (t, kind, f) in
+               enumerate(votes[self._vote_ev_done:])]
+        out += [(t, 1, i, "actuator_state", {"state": state, "channel": ch}) for i, (t, state, ch)
+                in enumerate(act.transitions[self._act_trans_done:])]
+        out.sort(key=lambda e: e[:3])
+        for t, _, _, kind, f in out:
+            self.event("actuators", kind, t_ns=t, **f)
+        self._act_trans_done = len(act.transitions)
+        self._vote_ev_done = len(votes)
 
     def _crash(self, reason: str) -> None:
         self.crash = (self.t_now, reason)
@@ -355,10 +399,16 @@ class World:
         self.finish(time.perf_counter() - wall0)
         return 0
 
+    def _vote_summary(self) -> dict | None:
+        sel = self.act.selector
+        if not isinstance(sel, VotingSelector):
+            return None
+        vp = self.voting
+        return {**sel.summary(), "thresholds": [_r(x, 6) for x in vp.thresholds],
+                "persist": vp.persist, "offset_s": vp.offset_s, "period_ms": vp.period_ms}
+
     def finish(self, wall_s: float) -> None:
-        if len(self.act.transitions) > self._act_trans_done:
-            for tt, state, ch in self.act.transitions[self._act_trans_done:]:
-                self.event("actuators", "actuator_state", t_ns=tt, state=state, channel=ch)
+        self._log_actuators()
         self.event("world", "stop", t_ns=self.t_end, reason=self.stop_reason)
         self.events_f.close()
         self.truth_f.close()
@@ -380,6 +430,8 @@ class World:
             "final": final,
             "frames_sent": dict(sorted(self.sent.items())),
             "frames_received": dict(sorted(self.received.items())),
+            "channels": self.opts.channels or 1,
+            "vote": self._vote_summary(),
         }
         (self.run_dir / "world.json").write_text(json.dumps(summary, indent=1) + "\n")
         emu = self.t_end / NS

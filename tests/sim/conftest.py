@@ -16,7 +16,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from fakebus import FakeBus, LoopbackBus  # noqa: E402
 
-from conftest_helpers import NS, PILOTS, act_cmd_injector  # noqa: E402
+from conftest_helpers import ACT_CMDS, NS, PILOTS, act_cmd_injector  # noqa: E402
 
 @dataclass
 class LocalRun:
@@ -36,13 +36,15 @@ class LocalRun:
 
 @pytest.fixture
 def local_world(tmp_path):
-    """local_world(script, seconds, cmd=None|'trim'|f(t, trim), seed=0, **opts) -> LocalRun."""
+    """local_world(script, seconds, cmd=None|'trim'|f(t, trim), seed=0, **opts) -> LocalRun.
+    channel_cmd=f(channel, t, trim) sends ACT_CMD_A, _B and _C (None: that channel is silent)."""
     from imaworld import pilot
     from imaworld.world import Options, World
 
     n = [0]
 
-    def run(script, seconds: float, cmd=None, seed: int = 0, extra_injector=None, **opts):
+    def run(script, seconds: float, cmd=None, seed: int = 0, extra_injector=None,
+            channel_cmd=None, **opts):
         n[0] += 1
         run_dir = tmp_path / f"local{n[0]}"
         if not isinstance(script, pilot.PilotScript):
@@ -56,6 +58,9 @@ def local_world(tmp_path):
             injectors.append(act_cmd_injector(lambda t: trim))
         elif cmd is not None:
             injectors.append(act_cmd_injector(lambda t: cmd(t, trim)))
+        if channel_cmd is not None:
+            injectors += [act_cmd_injector(lambda t, ch=ch: channel_cmd(ch, t, trim), msg)
+                          for ch, msg in enumerate(ACT_CMDS)]
         if extra_injector is not None:
             injectors.append(extra_injector)
         bus.injector = lambda a, b: [f for i in injectors for f in i(a, b)]

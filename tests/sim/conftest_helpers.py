@@ -11,6 +11,7 @@ ROOT = Path(__file__).resolve().parents[2]
 PILOTS = ROOT / "sim" / "pilots"
 NS = 1_000_000_000
 ACT_A = MESSAGES["ACT_CMD_A"]
+ACT_CMDS = tuple(MESSAGES[f"ACT_CMD_{c}"] for c in "ABC")  # redundancy channels A, B, C
 
 
 def act_cmd_injector(cmd_of_t, channel_msg=ACT_A, until_ns: int | None = None):

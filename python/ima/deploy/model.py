@@ -1,0 +1,205 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The system model: what config/systems/*.yaml holds, once loaded and checked."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ima.errors import ImaError
+
+NS_PER_S = 1_000_000_000
+
+# Redundancy channel letter of node index 1..3 (ARINC 825 RCI 0..2).
+CHANNEL_LETTERS = "ABC"
+
+# The emulator's system states and error identifiers (docs/health-monitoring.md), with the
+# descriptions the module's System_HM_Table carries.
+HM_STATES = {
+    "MODULE_INIT": (0, "module initialisation"),
+    "PARTITION_INIT": (1, "partition initialisation"),
+    "PROCESS": (2, "process execution"),
+    "ERROR_HANDLER": (3, "error handler"),
+}
+HM_ERRORS = {
+    "DEADLINE_MISSED": (1, "deadline missed"),
+    "APPLICATION_ERROR": (2, "application error"),
+    "NUMERIC_ERROR": (3, "numeric error"),
+    "ILLEGAL_REQUEST": (4, "illegal request"),
+    "STACK_OVERFLOW": (5, "stack overflow"),
+    "MEMORY_VIOLATION": (6, "memory violation"),
+    "HARDWARE_FAULT": (7, "hardware fault"),
+    "POWER_FAIL": (8, "power failure"),
+    "WINDOW_OVERRUN": (9, "window overrun"),
+    "PARTITION_EXIT": (10, "partition process ended"),
+}
+
+VOTING_AXES = ("elev", "ail", "rud", "thr")
+
+
+class SystemModelError(ImaError):
+    """A system model that cannot be read or breaks a rule; the message names file, line, path."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(message, exit_code=2)
+
+
+def seconds_text(ns: int) -> str:
+    """Decimal seconds as the module XML writes them: 50000000 -> '0.05', 10**9 -> '1.0'."""
+    whole, frac = divmod(ns, NS_PER_S)
+    return f"{whole}.{f'{frac:09d}'.rstrip('0') or '0'}"
+
+
+@dataclass(frozen=True)
+class Node:
+    """One processor. `index` 1..3 is its ARINC 825 redundancy channel A..C."""
+
+    name: str
+    index: int
+
+    @property
+    def channel(self) -> str:
+        """The redundancy channel letter: 'A' for index 1."""
+        return CHANNEL_LETTERS[self.index - 1]
+
+    @property
+    def rci(self) -> int:
+        """The redundancy channel number in a CAN identifier's last two bits (A = 0)."""
+        return self.index - 1
+
+
+@dataclass
+class Port:
+    name: str
+    direction: str  # "source" | "destination"
+    kind: str  # "sampling" | "queuing"
+    size: int
+    refresh_ns: int | None = None  # sampling ports
+    max_messages: int | None = None  # queuing ports
+
+    @property
+    def is_source(self) -> bool:
+        return self.direction == "source"
+
+
+@dataclass
+class Process:
+    name: str
+    period_ns: int
+    stack: int
+    priority: int
+    offset_ns: int = 0
+    deadline: str = "soft"
+
+
+@dataclass
+class Memory:
+    size: int
+    type: str | None = None
+    access: str | None = None
+
+
+@dataclass
+class Partition:
+    ident: int
+    name: str
+    criticality: str
+    system_partition: bool
+    personality: str
+    executable: str
+    arguments: list[str]
+    period_ns: int
+    processes: list[Process]
+    ports: list[Port]
+    memory: list[Memory]
+    # Partition_HM_Table: state -> error identifier -> action.
+    hm: dict[int, dict[int, str]] = field(default_factory=dict)
+
+    def port(self, name: str) -> Port | None:
+        return next((p for p in self.ports if p.name == name), None)
+
+    @property
+    def rate_hz(self) -> float:
+        return NS_PER_S / self.period_ns
+
+
+@dataclass
+class Window:
+    ident: int
+    partition: str
+    start_ns: int
+    duration_ns: int
+
+    @property
+    def end_ns(self) -> int:
+        return self.start_ns + self.duration_ns
+
+
+@dataclass
+class Endpoint:
+    partition: str
+    port: str
+
+    def __str__(self) -> str:
+        return f"{self.partition}.{self.port}"
+
+
+@dataclass
+class Channel:
+    ident: int
+    name: str
+    source: Endpoint
+    destinations: list[Endpoint]
+
+
+@dataclass
+class CanTraffic:
+    """The CAN messages one partition instance sends and receives on one node."""
+
+    sends: list[str]
+    receives: list[str]
+
+
+@dataclass
+class System:
+    """A loaded, checked system model. Times are exact integers of nanoseconds (`*_ns`)."""
+
+    name: str
+    path: Path
+    source: str  # the system file as generated files name it (relative to the repository)
+    application: str
+    version: str | None
+    time_mode: str | None
+    nodes: list[Node]
+    partitions: list[Partition]
+    replicated: list[str]
+    major_frame_ns: int
+    windows: list[Window]
+    hm_system: dict[int, dict[int, str]]  # System_HM_Table: state -> error -> level
+    hm_module: dict[int, dict[int, str]]  # Module_HM_Table: state -> error -> action
+    channels: list[Channel]
+    can: dict  # {"dbc": Path, "bitrate": int}
+    dds: dict  # {"config": Path, "liveliness_lease_s", "deadline_s", "topics": [names]}
+    dds_topics: list[dict]  # [{"name", "partition"}]
+    voting: dict  # {"thresholds": {axis: float}, "persist": int, "offset_s": float}
+    membership: dict  # {"heartbeat": str, "missed_frames": int}
+    # node name -> partition name -> its CAN traffic on that node ({channel} expanded).
+    can_traffic: dict[str, dict[str, CanTraffic]] = field(default_factory=dict)
+
+    @property
+    def major_frame_s(self) -> float:
+        return self.major_frame_ns / NS_PER_S
+
+    def partition(self, name: str) -> Partition | None:
+        return next((p for p in self.partitions if p.name == name), None)
+
+    def node(self, name: str) -> Node | None:
+        return next((n for n in self.nodes if n.name == name), None)
+
+    def channel_of(self, partition: str, port: str) -> Channel | None:
+        """The channel a port is an end of, if any."""
+        for ch in self.channels:
+            ends = [ch.source, *ch.destinations]
+            if any(e.partition == partition and e.port == port for e in ends):
+                return ch
+        return None

@@ -18,6 +18,8 @@ REQUIRED = [
     "libseccomp-dev",
     "python3-venv",
     "python3-dev",
+    "cyclonedds-dev",
+    "cyclonedds-tools",
 ]
 
 

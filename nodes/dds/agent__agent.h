@@ -1,0 +1,162 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The DDS agent's state, shared by its parts: DDS side (agent_dds.c), io link (agent_io.c),
+ * trace and statistics (agent_out.c) and the main loop (agent.c).
+ *
+ * Threads: Cyclone calls the listeners on its own threads; they only queue an event or set a
+ * flag and wake the main thread through a pipe. Everything else, DDS reads and writes
+ * included, happens on the main thread. */
+#ifndef AGENT__AGENT_H
+#define AGENT__AGENT_H
+
+#include <dds/dds.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "agent__agree.h"
+#include "xch/proto.h"
+
+enum { T_INPUTS, T_HEALTH, T_TELEMETRY, T_MISSION, T_COUNT };
+
+typedef struct {
+    unsigned node, nodes;
+    const char *socket_path;
+    uint32_t domain;
+    const char *config;        /* resolved path of the Cyclone configuration */
+    bool realtime;
+    int64_t xch_timeout_ns;    /* real time: longest wait for an AGREED */
+    int64_t lease_ns;          /* liveliness lease */
+    int64_t deadline_ns;       /* NodeHealth deadline */
+    int64_t startup_timeout_ns;/* how long to wait for the other agents at startup */
+    const char *bind_device;   /* interface the DDS sockets are bound to ("" = leave them) */
+    const char *trace_path, *stats_path;
+    bool quiet;
+} agent_opts_t;
+
+/* What a Cyclone listener tells the main thread. */
+typedef enum { EV_MATCHED, EV_LIVELINESS, EV_DEADLINE } agent_ev_kind_t;
+
+typedef struct {
+    agent_ev_kind_t kind;
+    int topic;
+    dds_instance_handle_t handle; /* publication (MATCHED, LIVELINESS) or instance (DEADLINE) */
+    int32_t change;               /* current/alive count change; DEADLINE: count change */
+    int32_t not_alive_change;
+} agent_ev_t;
+
+#define AGENT_EV_QUEUE 1024
+#define AGENT_MAX_WRITERS 64 /* remote writers remembered (handle -> node) */
+
+typedef struct {
+    dds_instance_handle_t handle;
+    int topic;
+    unsigned node;       /* 0 unknown (not an agent of this run) */
+    bool matched;
+} agent_writer_t;
+
+typedef struct {
+    bool discovered;     /* its inputs writer was matched at least once */
+    bool matched[T_COUNT];
+    bool alive;          /* its inputs writer is alive on DDS */
+    bool dead;           /* latched */
+    bool deadline_missed;/* a NodeHealth deadline miss traced, no sample since */
+    int64_t lost_wall_ns;
+    uint64_t deadline_misses;
+} agent_peer_t;
+
+typedef struct {
+    uint64_t written, read, invalid, write_errors, own;
+} agent_topic_stats_t;
+
+/* Latency samples of the exchange, request to AGREED, in ns. */
+#define AGENT_LAT_MAX (1u << 20)
+
+typedef struct agent agent_t;
+
+typedef struct {
+    agent_t *agent;
+    int topic;
+} agent_rd_ctx_t;
+
+struct agent {
+    agent_opts_t o;
+    char node_name[16];
+
+    /* DDS */
+    dds_entity_t pp, tp[T_COUNT], rd[T_COUNT], wr[T_COUNT];
+    agent_rd_ctx_t rd_ctx[T_COUNT];
+    agent_writer_t writers[AGENT_MAX_WRITERS];
+    int n_writers;
+    unsigned bound_sockets;    /* UDP sockets bound to opts.bind_device */
+
+    /* listener -> main thread */
+    pthread_mutex_t lock;
+    agent_ev_t evq[AGENT_EV_QUEUE];
+    unsigned ev_head, ev_count;
+    uint64_t ev_dropped;
+    atomic_bool wake_pending;
+    int wake_rd, wake_wr;
+    int sig_fd;
+    bool stop;
+
+    /* io link */
+    int listen_fd, io_fd;
+    bool io_hello;             /* HELLO received on io_fd */
+    uint64_t io_connections, io_disconnects;
+    bool own_instance;         /* our CrossChannelInputs instance is registered (not disposed) */
+
+    /* the exchange */
+    agree_t agree;
+    agent_peer_t peer[XCH_MAX_NODES];
+    bool pending;
+    uint32_t pend_frame, pend_mask;
+    int64_t pend_t_ns;
+    int64_t pend_start_ns;     /* CLOCK_MONOTONIC of the request */
+    bool pend_waited;
+    int64_t last_t_ns;         /* emulated time of the latest request (for the trace) */
+
+    /* statistics */
+    agent_topic_stats_t ts[T_COUNT];
+    uint64_t agreed, waits, timeouts, superseded, bad_datagrams, partial;
+    uint32_t *lat_ns;
+    uint32_t n_lat;
+    int64_t start_mono_ns;
+
+    FILE *trace;
+    uint64_t traced_bad;
+};
+
+int64_t agent_mono_ns(void);
+int64_t agent_wall_ns(void);
+
+/* agent_dds.c */
+int agent_dds_start(agent_t *a);
+void agent_dds_stop(agent_t *a);
+void agent_dds_process_events(agent_t *a);
+void agent_dds_take_all(agent_t *a);
+bool agent_dds_discovery_complete(agent_t *a, uint32_t *missing);
+int agent_dds_publish(agent_t *a, int topic, const struct xch_hdr *h, const void *payload);
+void agent_dds_withdraw(agent_t *a);
+unsigned agent_dds_bind_sockets(agent_t *a);
+
+/* agent_io.c */
+int agent_io_listen(agent_t *a);
+void agent_io_accept(agent_t *a);
+void agent_io_readable(agent_t *a);
+void agent_io_close(agent_t *a, const char *reason);
+void agent_io_check_pending(agent_t *a, bool timed_out);
+void agent_io_shutdown(agent_t *a);
+
+/* agent_out.c: the trace (one JSON object per line) and the statistics. */
+/* Starts a trace line with the common fields; false (write nothing more) without a trace. */
+bool agent_trace_begin(agent_t *a, const char *kind);
+void agent_trace_end(agent_t *a);
+void agent_trace_simple(agent_t *a, const char *kind);
+/* Writes the nodes of mask as a JSON array member: ,"key":["node1",...] */
+void agent_trace_nodes(agent_t *a, const char *key, uint32_t mask);
+int agent_write_stats(agent_t *a);
+void agent_log(agent_t *a, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+#endif

@@ -1,0 +1,604 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The DDS side of the agent: participant, topics, QoS, listeners, peers' liveliness, samples. */
+#include <dirent.h>
+#include <errno.h>
+#include <inttypes.h>
+#include <net/if.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include "agent__agent.h"
+#include "rpas.h"
+
+static const char *const topic_name[T_COUNT] = {"rpas_CrossChannelInputs", "rpas_NodeHealth",
+                                                 "rpas_Telemetry", "rpas_MissionData"};
+static const dds_topic_descriptor_t *const topic_desc[T_COUNT] = {
+    &rpas_CrossChannelInputs_desc, &rpas_NodeHealth_desc, &rpas_Telemetry_desc,
+    &rpas_MissionData_desc};
+
+/* Every endpoint of an agent carries this in its USER_DATA, so that a peer can tell which
+ * node a matched writer belongs to before it has published anything. */
+#define UDATA_FMT "ima-node=%u"
+
+/* ---- listeners: Cyclone's threads ------------------------------------------------------ */
+
+static void wake(agent_t *a)
+{
+    if (!atomic_exchange(&a->wake_pending, true)) {
+        char c = 1;
+        if (write(a->wake_wr, &c, 1) < 0) {
+            /* the pipe is full: the main thread is awake anyway */
+        }
+    }
+}
+
+static void push_event(agent_t *a, const agent_ev_t *ev)
+{
+    pthread_mutex_lock(&a->lock);
+    if (a->ev_count < AGENT_EV_QUEUE) {
+        a->evq[(a->ev_head + a->ev_count) % AGENT_EV_QUEUE] = *ev;
+        a->ev_count++;
+    } else {
+        a->ev_dropped++;
+    }
+    pthread_mutex_unlock(&a->lock);
+    wake(a);
+}
+
+static void on_data_available(dds_entity_t rd, void *arg)
+{
+    (void)rd;
+    wake(((agent_rd_ctx_t *)arg)->agent);
+}
+
+/* Cyclone calls this once per match or unmatch (ddsperf relies on the same). */
+static void on_subscription_matched(dds_entity_t rd, const dds_subscription_matched_status_t st,
+                                    void *arg)
+{
+    (void)rd;
+    agent_rd_ctx_t *c = arg;
+    agent_ev_t ev = {.kind = EV_MATCHED, .topic = c->topic, .handle = st.last_publication_handle,
+                     .change = st.current_count_change};
+    push_event(c->agent, &ev);
+}
+
+static void on_liveliness_changed(dds_entity_t rd, const dds_liveliness_changed_status_t st,
+                                  void *arg)
+{
+    (void)rd;
+    agent_rd_ctx_t *c = arg;
+    agent_ev_t ev = {.kind = EV_LIVELINESS, .topic = c->topic,
+                     .handle = st.last_publication_handle, .change = st.alive_count_change,
+                     .not_alive_change = st.not_alive_count_change};
+    push_event(c->agent, &ev);
+}
+
+static void on_deadline_missed(dds_entity_t rd, const dds_requested_deadline_missed_status_t st,
+                               void *arg)
+{
+    (void)rd;
+    agent_rd_ctx_t *c = arg;
+    agent_ev_t ev = {.kind = EV_DEADLINE, .topic = c->topic, .handle = st.last_instance_handle,
+                     .change = st.total_count_change};
+    push_event(c->agent, &ev);
+}
+
+/* ---- entities -------------------------------------------------------------------------- */
+
+static dds_qos_t *endpoint_qos(const agent_t *a, int topic, bool writer)
+{
+    dds_qos_t *q = dds_create_qos();
+    int32_t depth = topic == T_INPUTS ? 32 : 4;
+    dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
+    /* A reader that matches late (an agent slower to start, the listener tool) still gets the
+     * writer's last samples, as many as the history holds (Cyclone keeps what the durability
+     * service's history says, by default only the last): the first exchange does not depend
+     * on discovery order. */
+    dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
+    if (writer)
+        dds_qset_durability_service(q, 0, DDS_HISTORY_KEEP_LAST, depth, DDS_LENGTH_UNLIMITED,
+                                    DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
+    dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, a->o.lease_ns);
+    if (topic == T_HEALTH)
+        dds_qset_deadline(q, a->o.deadline_ns);
+    char ud[32];
+    int n = snprintf(ud, sizeof ud, UDATA_FMT, a->o.node);
+    dds_qset_userdata(q, ud, (size_t)n);
+    if (writer) {
+        /* Deleting a writer (the agent exits or dies) leaves its instance "no writers", which
+         * readers take as the node's loss; disposal is kept for "io link down". */
+        dds_qset_writer_data_lifecycle(q, false);
+    } else {
+        dds_qset_ignorelocal(q, DDS_IGNORELOCAL_PARTICIPANT);
+    }
+    return q;
+}
+
+int agent_dds_start(agent_t *a)
+{
+    a->pp = dds_create_participant((dds_domainid_t)a->o.domain, NULL, NULL);
+    if (a->pp < 0) {
+        fprintf(stderr, "ima-dds-node %s: cannot create the DDS participant on domain %u: %s\n",
+                a->node_name, a->o.domain, dds_strretcode(a->pp));
+        return -1;
+    }
+    for (int t = 0; t < T_COUNT; t++) {
+        a->tp[t] = dds_create_topic(a->pp, topic_desc[t], topic_name[t], NULL, NULL);
+        if (a->tp[t] < 0) {
+            fprintf(stderr, "ima-dds-node %s: cannot create topic %s: %s\n", a->node_name,
+                    topic_name[t], dds_strretcode(a->tp[t]));
+            return -1;
+        }
+    }
+    for (int t = 0; t < T_COUNT; t++) {
+        a->rd_ctx[t] = (agent_rd_ctx_t){a, t};
+        dds_listener_t *l = dds_create_listener(&a->rd_ctx[t]);
+        dds_lset_data_available(l, on_data_available);
+        dds_lset_subscription_matched(l, on_subscription_matched);
+        if (t == T_INPUTS)
+            dds_lset_liveliness_changed(l, on_liveliness_changed);
+        if (t == T_HEALTH)
+            dds_lset_requested_deadline_missed(l, on_deadline_missed);
+        dds_qos_t *q = endpoint_qos(a, t, false);
+        a->rd[t] = dds_create_reader(a->pp, a->tp[t], q, l);
+        dds_delete_qos(q);
+        dds_delete_listener(l);
+        if (a->rd[t] < 0) {
+            fprintf(stderr, "ima-dds-node %s: cannot create the %s reader: %s\n", a->node_name,
+                    topic_name[t], dds_strretcode(a->rd[t]));
+            return -1;
+        }
+        q = endpoint_qos(a, t, true);
+        a->wr[t] = dds_create_writer(a->pp, a->tp[t], q, NULL);
+        dds_delete_qos(q);
+        if (a->wr[t] < 0) {
+            fprintf(stderr, "ima-dds-node %s: cannot create the %s writer: %s\n", a->node_name,
+                    topic_name[t], dds_strretcode(a->wr[t]));
+            return -1;
+        }
+    }
+    a->bound_sockets = agent_dds_bind_sockets(a);
+    return 0;
+}
+
+void agent_dds_stop(agent_t *a)
+{
+    if (a->pp > 0)
+        dds_delete(a->pp); /* readers and writers with it: peers see this node's writers go */
+    a->pp = 0;
+}
+
+/* Cyclone 0.10 binds its unicast receive sockets to INADDR_ANY whatever the configured
+ * interface (only the transmit socket gets the interface address). Binding every one of this
+ * process's IP sockets to the configured device makes the kernel deliver to them only what
+ * came in on that device, and send from them only through it. Returns the count bound. */
+unsigned agent_dds_bind_sockets(agent_t *a)
+{
+    const char *dev = a->o.bind_device;
+    if (!dev || !*dev)
+        return 0;
+    DIR *d = opendir("/proc/self/fd");
+    if (!d) {
+        agent_log(a, "cannot list /proc/self/fd: %s; DDS sockets left as they are",
+                  strerror(errno));
+        return 0;
+    }
+    unsigned bound = 0;
+    int dfd = dirfd(d);
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        char *end;
+        long fd = strtol(e->d_name, &end, 10);
+        if (*end || end == e->d_name || fd == dfd)
+            continue;
+        int domain = 0;
+        socklen_t len = sizeof domain;
+        if (getsockopt((int)fd, SOL_SOCKET, SO_DOMAIN, &domain, &len) != 0)
+            continue; /* not a socket */
+        if (domain != AF_INET && domain != AF_INET6)
+            continue;
+        char cur[IFNAMSIZ] = "";
+        len = sizeof cur;
+        if (getsockopt((int)fd, SOL_SOCKET, SO_BINDTODEVICE, cur, &len) == 0 && cur[0]) {
+            if (strcmp(cur, dev) == 0)
+                bound++;
+            else
+                agent_log(a, "DDS socket %ld is bound to device %s, not %s", fd, cur, dev);
+            continue;
+        }
+        if (setsockopt((int)fd, SOL_SOCKET, SO_BINDTODEVICE, dev, (socklen_t)strlen(dev) + 1) !=
+            0) {
+            agent_log(a, "cannot bind DDS socket %ld to %s: %s", fd, dev, strerror(errno));
+            continue;
+        }
+        bound++;
+    }
+    closedir(d);
+    return bound;
+}
+
+/* ---- peers ----------------------------------------------------------------------------- */
+
+static agent_writer_t *writer_find(agent_t *a, int topic, dds_instance_handle_t h)
+{
+    for (int i = 0; i < a->n_writers; i++)
+        if (a->writers[i].handle == h && a->writers[i].topic == topic)
+            return &a->writers[i];
+    return NULL;
+}
+
+static agent_writer_t *writer_add(agent_t *a, int topic, dds_instance_handle_t h, unsigned node)
+{
+    agent_writer_t *w = writer_find(a, topic, h);
+    if (w) {
+        if (node)
+            w->node = node;
+        return w;
+    }
+    if (a->n_writers == AGENT_MAX_WRITERS) {
+        /* forget an unmatched one */
+        for (int i = 0; i < a->n_writers; i++)
+            if (!a->writers[i].matched) {
+                a->writers[i] = a->writers[--a->n_writers];
+                break;
+            }
+        if (a->n_writers == AGENT_MAX_WRITERS)
+            return NULL;
+    }
+    w = &a->writers[a->n_writers++];
+    *w = (agent_writer_t){.handle = h, .topic = topic, .node = node};
+    return w;
+}
+
+/* The node a remote writer belongs to, from its USER_DATA; 0 if unknown. */
+static unsigned writer_node(agent_t *a, int topic, dds_instance_handle_t h)
+{
+    agent_writer_t *w = writer_find(a, topic, h);
+    if (w && w->node)
+        return w->node;
+    unsigned node = 0;
+    dds_builtintopic_endpoint_t *ep = dds_get_matched_publication_data(a->rd[topic], h);
+    if (ep) {
+        void *ud = NULL;
+        size_t sz = 0;
+        if (ep->qos && dds_qget_userdata(ep->qos, &ud, &sz) && ud && sz > 0 && sz < 32) {
+            char buf[32];
+            memcpy(buf, ud, sz);
+            buf[sz] = 0;
+            unsigned k;
+            char extra;
+            if (sscanf(buf, UDATA_FMT "%c", &k, &extra) == 1 && k >= 1 && k <= a->o.nodes)
+                node = k;
+        }
+        dds_free(ud);
+        dds_builtintopic_free_endpoint(ep);
+    }
+    if (node)
+        writer_add(a, topic, h, node);
+    return node;
+}
+
+static void peer_lost(agent_t *a, unsigned k, const char *reason)
+{
+    if (k < 1 || k > a->o.nodes || k == a->o.node)
+        return;
+    agent_peer_t *p = &a->peer[k - 1];
+    bool was_alive = p->alive;
+    p->alive = false;
+    if (p->dead)
+        return;
+    p->dead = true;
+    p->lost_wall_ns = agent_wall_ns();
+    agree_set_dead(&a->agree, k);
+    if (agent_trace_begin(a, "dds_peer_lost")) {
+        fprintf(a->trace, ",\"peer\":\"node%u\",\"reason\":\"%s\",\"was_alive\":%s", k, reason,
+                was_alive ? "true" : "false");
+        agent_trace_end(a);
+    }
+    agent_log(a, "node%u lost on DDS (%s): no longer waited for", k, reason);
+}
+
+static void peer_alive(agent_t *a, unsigned k)
+{
+    if (k < 1 || k > a->o.nodes || k == a->o.node)
+        return;
+    agent_peer_t *p = &a->peer[k - 1];
+    if (p->alive)
+        return;
+    p->alive = true;
+    if (agent_trace_begin(a, "dds_peer_alive")) {
+        fprintf(a->trace, ",\"peer\":\"node%u\"", k);
+        if (p->dead)
+            fputs(",\"ignored\":\"latched dead for the run\"", a->trace);
+        agent_trace_end(a);
+    }
+}
+
+static void handle_matched(agent_t *a, const agent_ev_t *ev)
+{
+    if (ev->change > 0) {
+        unsigned k = writer_node(a, ev->topic, ev->handle);
+        agent_writer_t *w = writer_add(a, ev->topic, ev->handle, k);
+        if (w)
+            w->matched = true;
+        if (k && k != a->o.node) {
+            a->peer[k - 1].matched[ev->topic] = true;
+            if (ev->topic == T_INPUTS)
+                a->peer[k - 1].discovered = true;
+        }
+        return;
+    }
+    if (ev->change < 0) {
+        agent_writer_t *w = writer_find(a, ev->topic, ev->handle);
+        if (!w)
+            return;
+        w->matched = false;
+        unsigned k = w->node;
+        if (k && k != a->o.node) {
+            a->peer[k - 1].matched[ev->topic] = false;
+            if (ev->topic == T_INPUTS)
+                peer_lost(a, k, "unmatched");
+        }
+    }
+}
+
+static void handle_liveliness(agent_t *a, const agent_ev_t *ev)
+{
+    unsigned k = writer_node(a, ev->topic, ev->handle);
+    if (!k) {
+        agent_writer_t *w = writer_find(a, ev->topic, ev->handle);
+        k = w ? w->node : 0;
+    }
+    if (!k || k == a->o.node)
+        return;
+    if (ev->change > 0)
+        peer_alive(a, k);
+    else if (ev->change < 0)
+        peer_lost(a, k, ev->not_alive_change > 0 ? "liveliness" : "writer_gone");
+}
+
+static void handle_deadline(agent_t *a, const agent_ev_t *ev)
+{
+    rpas_NodeHealth key;
+    memset(&key, 0, sizeof key);
+    if (dds_instance_get_key(a->rd[T_HEALTH], ev->handle, &key) != DDS_RETCODE_OK)
+        return;
+    unsigned k = key.node;
+    if (k < 1 || k > a->o.nodes || k == a->o.node)
+        return;
+    agent_peer_t *p = &a->peer[k - 1];
+    p->deadline_misses += ev->change > 0 ? (uint64_t)ev->change : 1;
+    if (p->deadline_missed)
+        return; /* one line per episode: until the node publishes its health again */
+    p->deadline_missed = true;
+    if (agent_trace_begin(a, "dds_deadline_missed")) {
+        fprintf(a->trace, ",\"peer\":\"node%u\",\"topic\":\"rpas_NodeHealth\",\"deadline_ms\":%.1f",
+                k, a->o.deadline_ns / 1e6);
+        agent_trace_end(a);
+    }
+}
+
+void agent_dds_process_events(agent_t *a)
+{
+    for (;;) {
+        agent_ev_t ev;
+        pthread_mutex_lock(&a->lock);
+        bool have = a->ev_count > 0;
+        if (have) {
+            ev = a->evq[a->ev_head];
+            a->ev_head = (a->ev_head + 1) % AGENT_EV_QUEUE;
+            a->ev_count--;
+        }
+        pthread_mutex_unlock(&a->lock);
+        if (!have)
+            return;
+        switch (ev.kind) {
+        case EV_MATCHED:
+            handle_matched(a, &ev);
+            break;
+        case EV_LIVELINESS:
+            handle_liveliness(a, &ev);
+            break;
+        case EV_DEADLINE:
+            handle_deadline(a, &ev);
+            break;
+        }
+    }
+}
+
+bool agent_dds_discovery_complete(agent_t *a, uint32_t *missing)
+{
+    uint32_t m = 0;
+    for (unsigned k = 1; k <= a->o.nodes; k++) {
+        if (k == a->o.node)
+            continue;
+        for (int t = 0; t < T_COUNT; t++)
+            if (!a->peer[k - 1].matched[t])
+                m |= 1u << (k - 1);
+    }
+    if (missing)
+        *missing = m;
+    return m == 0;
+}
+
+/* ---- samples --------------------------------------------------------------------------- */
+
+static void inputs_from_dds(struct xch_inputs *x, const rpas_CrossChannelInputs *s)
+{
+    memset(x, 0, sizeof *x);
+    x->valid = s->valid;
+    x->wait_mask = s->wait_mask;
+    x->gps_t_ns = s->gps_t_ns;
+    x->ahrs_t_ns = s->ahrs_t_ns;
+    x->air_t_ns = s->air_t_ns;
+    x->gps_seq = s->gps_seq;
+    x->gps_fix = s->gps_fix;
+    x->gps_sats = s->gps_sats;
+    x->ahrs_seq = s->ahrs_seq;
+    x->ahrs_status = s->ahrs_status;
+    x->air_seq = s->air_seq;
+    x->air_status = s->air_status;
+    memcpy(x->gps, s->gps, sizeof x->gps);
+    memcpy(x->ahrs, s->ahrs, sizeof x->ahrs);
+    memcpy(x->air, s->air, sizeof x->air);
+}
+
+static void inputs_to_dds(rpas_CrossChannelInputs *s, const struct xch_inputs *x)
+{
+    s->valid = x->valid;
+    s->wait_mask = x->wait_mask;
+    s->gps_t_ns = x->gps_t_ns;
+    s->ahrs_t_ns = x->ahrs_t_ns;
+    s->air_t_ns = x->air_t_ns;
+    s->gps_seq = x->gps_seq;
+    s->gps_fix = x->gps_fix;
+    s->gps_sats = x->gps_sats;
+    s->ahrs_seq = x->ahrs_seq;
+    s->ahrs_status = x->ahrs_status;
+    s->air_seq = x->air_seq;
+    s->air_status = x->air_status;
+    memcpy(s->gps, x->gps, sizeof s->gps);
+    memcpy(s->ahrs, x->ahrs, sizeof s->ahrs);
+    memcpy(s->air, x->air, sizeof s->air);
+}
+
+#define TAKE_MAX 32
+
+static void take_topic(agent_t *a, int t)
+{
+    static union {
+        rpas_CrossChannelInputs in;
+        rpas_NodeHealth h;
+        rpas_Telemetry tm;
+        rpas_MissionData m;
+    } buf[TAKE_MAX];
+    void *ptrs[TAKE_MAX];
+    dds_sample_info_t si[TAKE_MAX];
+    for (int i = 0; i < TAKE_MAX; i++)
+        ptrs[i] = &buf[i];
+    for (;;) {
+        int32_t n = dds_take(a->rd[t], ptrs, si, TAKE_MAX, TAKE_MAX);
+        if (n <= 0)
+            return;
+        for (int32_t i = 0; i < n; i++) {
+            /* every topic type starts with the node key */
+            unsigned k = *(const uint32_t *)ptrs[i];
+            if (!si[i].valid_data) {
+                a->ts[t].invalid++;
+                if (t != T_INPUTS)
+                    continue;
+                rpas_CrossChannelInputs key;
+                memset(&key, 0, sizeof key);
+                if (dds_instance_get_key(a->rd[t], si[i].instance_handle, &key) == 0)
+                    k = key.node;
+                if (k < 1 || k > a->o.nodes || k == a->o.node)
+                    continue;
+                if (si[i].instance_state == DDS_IST_NOT_ALIVE_NO_WRITERS) {
+                    peer_lost(a, k, "no_writers");
+                } else if (si[i].instance_state == DDS_IST_NOT_ALIVE_DISPOSED) {
+                    agree_set_withdrawn(&a->agree, k);
+                    if (agent_trace_begin(a, "xch_peer_withdrawn")) {
+                        fprintf(a->trace, ",\"peer\":\"node%u\"", k);
+                        agent_trace_end(a);
+                    }
+                }
+                continue;
+            }
+            if (k < 1 || k > a->o.nodes || k == a->o.node) {
+                a->ts[t].invalid++; /* not a node of this system: ignored */
+                continue;
+            }
+            a->ts[t].read++;
+            writer_add(a, t, si[i].publication_handle, k);
+            if (t == T_INPUTS) {
+                struct xch_inputs x;
+                inputs_from_dds(&x, &buf[i].in);
+                agree_store(&a->agree, k, buf[i].in.frame, buf[i].in.t_ns, &x);
+            } else if (t == T_HEALTH) {
+                a->peer[k - 1].deadline_missed = false;
+            }
+        }
+    }
+}
+
+void agent_dds_take_all(agent_t *a)
+{
+    for (int t = 0; t < T_COUNT; t++)
+        take_topic(a, t);
+}
+
+int agent_dds_publish(agent_t *a, int topic, const struct xch_hdr *h, const void *payload)
+{
+    union {
+        rpas_CrossChannelInputs in;
+        rpas_NodeHealth h;
+        rpas_Telemetry tm;
+        rpas_MissionData m;
+    } s;
+    memset(&s, 0, sizeof s);
+    switch (topic) {
+    case T_INPUTS: {
+        inputs_to_dds(&s.in, payload);
+        s.in.node = a->o.node;
+        s.in.frame = h->frame;
+        s.in.t_ns = h->t_ns;
+        break;
+    }
+    case T_HEALTH: {
+        const struct xch_health *x = payload;
+        s.h = (rpas_NodeHealth){.node = a->o.node, .frame = h->frame, .t_ns = h->t_ns,
+                                .membership = x->membership, .flags = x->flags,
+                                .fcs_mode = x->fcs_mode, .failed = x->failed};
+        break;
+    }
+    case T_TELEMETRY: {
+        const struct xch_telemetry *x = payload;
+        s.tm = (rpas_Telemetry){.node = a->o.node, .frame = h->frame, .t_ns = h->t_ns,
+                                .fcs_mode = x->fcs_mode, .fallback = x->fallback,
+                                .nav_flags = x->nav_flags, .lat_deg = x->lat_deg,
+                                .lon_deg = x->lon_deg, .alt_ft = x->alt_ft, .ias_kt = x->ias_kt,
+                                .gs_kt = x->gs_kt, .hdg_deg = x->hdg_deg, .trk_deg = x->trk_deg,
+                                .vs_fpm = x->vs_fpm, .roll_deg = x->roll_deg,
+                                .pitch_deg = x->pitch_deg};
+        memcpy(s.tm.cmd, x->cmd, sizeof s.tm.cmd);
+        break;
+    }
+    case T_MISSION: {
+        const struct xch_mission *x = payload;
+        s.m = (rpas_MissionData){.node = a->o.node, .frame = h->frame, .t_ns = h->t_ns,
+                                 .mode = x->mode, .lat_mode = x->lat_mode,
+                                 .vert_mode = x->vert_mode, .hdg_deg = x->hdg_deg,
+                                 .alt_ft = x->alt_ft, .ias_kt = x->ias_kt, .vs_fpm = x->vs_fpm};
+        break;
+    }
+    default:
+        return -1;
+    }
+    dds_return_t rc = dds_write(a->wr[topic], &s);
+    if (rc != DDS_RETCODE_OK) {
+        a->ts[topic].write_errors++;
+        agent_log(a, "writing %s failed: %s", topic_name[topic], dds_strretcode(rc));
+        return -1;
+    }
+    a->ts[topic].written++;
+    if (topic == T_INPUTS)
+        a->own_instance = true;
+    return 0;
+}
+
+/* The io link is down: dispose this node's inputs instance, so that the other nodes stop
+ * waiting for frames it will not publish (agent__agree.h). */
+void agent_dds_withdraw(agent_t *a)
+{
+    if (!a->own_instance)
+        return;
+    rpas_CrossChannelInputs key;
+    memset(&key, 0, sizeof key);
+    key.node = a->o.node;
+    if (dds_dispose(a->wr[T_INPUTS], &key) != DDS_RETCODE_OK)
+        a->ts[T_INPUTS].write_errors++;
+    a->own_instance = false;
+}

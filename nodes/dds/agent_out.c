@@ -1,0 +1,158 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The DDS agent's trace (JSON lines), statistics (one JSON object at exit) and log lines. */
+#include <errno.h>
+#include <inttypes.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "agent__agent.h"
+
+static const char *const topic_names[T_COUNT] = {"rpas_CrossChannelInputs", "rpas_NodeHealth",
+                                                  "rpas_Telemetry", "rpas_MissionData"};
+
+int64_t agent_mono_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+int64_t agent_wall_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+void agent_log(agent_t *a, const char *fmt, ...)
+{
+    if (a->o.quiet)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "ima-dds-node %s: ", a->node_name);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+/* The trace has no emulated clock of its own: t_ns is the emulated time of the latest
+ * request from io (0 before the first), t_wall_ns the wall clock of the event. */
+bool agent_trace_begin(agent_t *a, const char *kind)
+{
+    if (!a->trace)
+        return false;
+    fprintf(a->trace,
+            "{\"t_wall_ns\":%" PRId64 ",\"t_ns\":%" PRId64
+            ",\"node\":\"%s\",\"src\":\"dds\",\"kind\":\"%s\"",
+            agent_wall_ns(), a->last_t_ns, a->node_name, kind);
+    return true;
+}
+
+void agent_trace_end(agent_t *a)
+{
+    fputs("}\n", a->trace);
+    /* Events are rare: flushing each keeps the trace complete if the agent is killed. */
+    fflush(a->trace);
+}
+
+void agent_trace_simple(agent_t *a, const char *kind)
+{
+    if (agent_trace_begin(a, kind))
+        agent_trace_end(a);
+}
+
+void agent_trace_nodes(agent_t *a, const char *key, uint32_t mask)
+{
+    fprintf(a->trace, ",\"%s\":[", key);
+    bool first = true;
+    for (unsigned k = 1; k <= 32; k++)
+        if (mask & (1u << (k - 1))) {
+            fprintf(a->trace, "%s\"node%u\"", first ? "" : ",", k);
+            first = false;
+        }
+    fputc(']', a->trace);
+}
+
+static int cmp_u32(const void *x, const void *y)
+{
+    uint32_t p = *(const uint32_t *)x, q = *(const uint32_t *)y;
+    return p < q ? -1 : p > q;
+}
+
+static double pct_us(const uint32_t *sorted, uint32_t n, double p)
+{
+    /* nearest-rank percentile */
+    uint32_t i = (uint32_t)(p * n / 100.0 + 0.999999);
+    if (i < 1)
+        i = 1;
+    if (i > n)
+        i = n;
+    return sorted[i - 1] / 1000.0;
+}
+
+int agent_write_stats(agent_t *a)
+{
+    if (!a->o.stats_path)
+        return 0;
+    FILE *f = fopen(a->o.stats_path, "w");
+    if (!f) {
+        fprintf(stderr, "ima-dds-node %s: cannot write statistics to %s: %s\n", a->node_name,
+                a->o.stats_path, strerror(errno));
+        return -1;
+    }
+    fprintf(f, "{\"node\":%u,\"nodes\":%u,\"domain\":%u,\"mode\":\"%s\",\"wall_s\":%.3f,",
+            a->o.node, a->o.nodes, a->o.domain, a->o.realtime ? "realtime" : "emulated",
+            (agent_mono_ns() - a->start_mono_ns) / 1e9);
+    fputs("\"topics\":{", f);
+    for (int t = 0; t < T_COUNT; t++)
+        fprintf(f,
+                "%s\"%s\":{\"written\":%" PRIu64 ",\"read\":%" PRIu64 ",\"invalid\":%" PRIu64
+                ",\"write_errors\":%" PRIu64 "}",
+                t ? "," : "", topic_names[t], a->ts[t].written, a->ts[t].read, a->ts[t].invalid,
+                a->ts[t].write_errors);
+    fprintf(f,
+            "},\"agreed_frames\":%" PRIu64 ",\"partial\":%" PRIu64 ",\"waits\":%" PRIu64
+            ",\"timeouts\":%" PRIu64 ",\"superseded\":%" PRIu64 ",\"stale\":%" PRIu64
+            ",\"bad_datagrams\":%" PRIu64 ",\"io_connections\":%" PRIu64
+            ",\"io_disconnects\":%" PRIu64 ",\"events_dropped\":%" PRIu64
+            ",\"bound_sockets\":%u,",
+            a->agreed, a->partial, a->waits, a->timeouts, a->superseded, a->agree.stale,
+            a->bad_datagrams, a->io_connections, a->io_disconnects, a->ev_dropped,
+            a->bound_sockets);
+    fprintf(f, "\"exchange_latency_us\":");
+    uint32_t *sorted = a->n_lat ? malloc(a->n_lat * sizeof *sorted) : NULL;
+    if (sorted) {
+        memcpy(sorted, a->lat_ns, a->n_lat * sizeof *sorted);
+        qsort(sorted, a->n_lat, sizeof *sorted, cmp_u32);
+        fprintf(f, "{\"count\":%u,\"median\":%.1f,\"p95\":%.1f,\"max\":%.1f}", a->n_lat,
+                pct_us(sorted, a->n_lat, 50), pct_us(sorted, a->n_lat, 95),
+                sorted[a->n_lat - 1] / 1000.0);
+        free(sorted);
+    } else {
+        fprintf(f, "{\"count\":0,\"median\":null,\"p95\":null,\"max\":null}");
+    }
+    fputs(",\"peers\":[", f);
+    bool first = true;
+    for (unsigned k = 1; k <= a->o.nodes; k++) {
+        if (k == a->o.node)
+            continue;
+        const agent_peer_t *p = &a->peer[k - 1];
+        fprintf(f,
+                "%s{\"node\":%u,\"discovered\":%s,\"alive\":%s,\"dead\":%s,"
+                "\"lost_wall_ns\":%" PRId64 ",\"deadline_misses\":%" PRIu64 "}",
+                first ? "" : ",", k, p->discovered ? "true" : "false",
+                p->alive ? "true" : "false", p->dead ? "true" : "false", p->lost_wall_ns,
+                p->deadline_misses);
+        first = false;
+    }
+    fputs("]}\n", f);
+    if (fclose(f) != 0) {
+        fprintf(stderr, "ima-dds-node %s: cannot write statistics to %s: %s\n", a->node_name,
+                a->o.stats_path, strerror(errno));
+        return -1;
+    }
+    return 0;
+}

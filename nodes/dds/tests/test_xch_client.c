@@ -1,0 +1,199 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The io partition's xch client under the system partitions' seccomp policy, against a fake agent.
+ *
+ * The child installs the RUN filter an io partition runs under (ske_sandbox_build with
+ * SKE_SANDBOX_IO) and then does everything the io partition does with the client: connect,
+ * exchange, publish, time out, close. A call outside the policy kills it with SIGSYS. The
+ * parent plays the agent and checks every datagram. (Sanitizer builds skip the filter: their
+ * runtime makes calls a partition may not.) */
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "ske_abi.h"
+#include "ske_sandbox.h"
+#include "xch/client.h"
+
+#if defined(__SANITIZE_ADDRESS__)
+#define SANDBOXED 0
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SANDBOXED 0
+#endif
+#endif
+#ifndef SANDBOXED
+#define SANDBOXED 1
+#endif
+
+static int failures;
+
+#define CHECK(cond)                                                                           \
+    do {                                                                                      \
+        if (!(cond)) {                                                                        \
+            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);          \
+            failures++;                                                                       \
+        }                                                                                     \
+    } while (0)
+
+/* ---- the child: an io partition ------------------------------------------------------ */
+
+static int child(const char *path)
+{
+    if (SANDBOXED) {
+        ske_sandbox_policy_t pol = {.flags = SKE_SANDBOX_IO, .self = getpid()};
+        static ske_sandbox_prog_t prog;
+        if (ske_sandbox_build(&pol, SKE_SANDBOX_RUN, &prog) != 0 ||
+            ske_sandbox_install(&prog) != 0) {
+            fprintf(stderr, "child: cannot install the partition filter\n");
+            return 10;
+        }
+    }
+    xch_client_t c;
+    char err[256];
+    int rc = xch_client_connect(&c, path, 2, err, sizeof err);
+    if (rc != 0) {
+        fprintf(stderr, "child: connect: %s\n", err);
+        return 11;
+    }
+    if (c.nodes != 3)
+        return 12;
+    struct xch_inputs mine;
+    memset(&mine, 0, sizeof mine);
+    mine.valid = XCH_IN_GPS | XCH_IN_AIR;
+    mine.wait_mask = 7;
+    mine.gps[0] = 47.25;
+    struct xch_agreed g;
+    rc = xch_client_exchange(&c, 7, 350000000, &mine, &g);
+    if (rc != 0 || g.present != 0x3 || g.in[0].gps_seq != 99 || g.in[1].gps[0] != 47.25)
+        return 13;
+    if (c.stale != 1 || c.rejected != 1)
+        return 14;
+    struct xch_health h = {.membership = 7, .fcs_mode = 2};
+    struct xch_telemetry t = {.fcs_mode = 2, .lat_deg = 1.5};
+    struct xch_mission m = {.mode = 3, .alt_ft = 3000};
+    if (xch_client_send(&c, XCH_HEALTH, 7, 350000000, &h, sizeof h) != 0 ||
+        xch_client_send(&c, XCH_TELEMETRY, 7, 350000000, &t, sizeof t) != 0 ||
+        xch_client_send(&c, XCH_MISSION, 7, 350000000, &m, sizeof m) != 0)
+        return 15;
+    if (xch_client_send(&c, XCH_HEALTH, 7, 0, &h, sizeof h - 1) != -EINVAL ||
+        xch_client_send(&c, XCH_AGREED, 7, 0, &g, sizeof g) != -EINVAL)
+        return 16;
+    /* nothing comes for frame 8: the wait ends by its timeout */
+    if (xch_client_await(&c, 8, &g, 50) != -ETIMEDOUT)
+        return 17;
+    /* the agent goes away */
+    if (xch_client_await(&c, 9, &g, 5000) != -ESHUTDOWN)
+        return 18;
+    xch_client_close(&c);
+    return 0;
+}
+
+/* ---- the parent: the agent ----------------------------------------------------------- */
+
+static long recv_hdr(int fd, struct xch_hdr *h, void *payload, size_t cap)
+{
+    unsigned char buf[1024];
+    ssize_t n = recv(fd, buf, sizeof buf, 0);
+    if (n < (ssize_t)sizeof *h)
+        return -1;
+    memcpy(h, buf, sizeof *h);
+    if ((size_t)n - sizeof *h > cap)
+        return -1;
+    memcpy(payload, buf + sizeof *h, (size_t)n - sizeof *h);
+    return (long)n;
+}
+
+static void send_agreed(int fd, uint32_t node, uint32_t frame, const struct xch_agreed *g)
+{
+    struct {
+        struct xch_hdr h;
+        struct xch_agreed g;
+    } m = {.h = {XCH_MAGIC, XCH_VERSION, XCH_AGREED, node, frame, 0}, .g = *g};
+    CHECK(send(fd, &m, sizeof m, 0) == (ssize_t)sizeof m);
+}
+
+static void agent(int lfd)
+{
+    int fd = accept(lfd, NULL, NULL);
+    CHECK(fd >= 0);
+    struct xch_hdr h;
+    union {
+        struct xch_inputs in;
+        struct xch_health h;
+        struct xch_telemetry t;
+        struct xch_mission m;
+    } p;
+    CHECK(recv_hdr(fd, &h, &p, sizeof p) == (long)sizeof h);
+    CHECK(h.magic == XCH_MAGIC && h.version == XCH_VERSION && h.type == XCH_HELLO && h.node == 2);
+    struct xch_hdr w = {XCH_MAGIC, XCH_VERSION, XCH_WELCOME, 2, 3, 0};
+    CHECK(send(fd, &w, sizeof w, 0) == (ssize_t)sizeof w);
+
+    CHECK(recv_hdr(fd, &h, &p, sizeof p) == (long)(sizeof h + sizeof p.in));
+    CHECK(h.type == XCH_INPUTS && h.frame == 7 && h.t_ns == 350000000);
+    CHECK(p.in.wait_mask == 7 && p.in.gps[0] == 47.25);
+    struct xch_agreed g;
+    memset(&g, 0, sizeof g);
+    send_agreed(fd, 2, 6, &g); /* an old frame's answer: skipped */
+    struct xch_hdr junk = {XCH_MAGIC, XCH_VERSION, XCH_WELCOME, 2, 3, 0};
+    CHECK(send(fd, &junk, sizeof junk, 0) == (ssize_t)sizeof junk); /* rejected */
+    g.present = 0x3;
+    g.in[0].gps_seq = 99;
+    g.in[1] = p.in;
+    send_agreed(fd, 2, 7, &g);
+
+    CHECK(recv_hdr(fd, &h, &p, sizeof p) == (long)(sizeof h + sizeof p.h));
+    CHECK(h.type == XCH_HEALTH && p.h.membership == 7);
+    CHECK(recv_hdr(fd, &h, &p, sizeof p) == (long)(sizeof h + sizeof p.t));
+    CHECK(h.type == XCH_TELEMETRY && p.t.lat_deg == 1.5);
+    CHECK(recv_hdr(fd, &h, &p, sizeof p) == (long)(sizeof h + sizeof p.m));
+    CHECK(h.type == XCH_MISSION && p.m.alt_ft == 3000);
+    usleep(200000); /* past the child's 50 ms timeout */
+    close(fd);
+}
+
+int main(void)
+{
+    char dir[] = "/tmp/xch-client-XXXXXX";
+    if (!mkdtemp(dir))
+        return 1;
+    char path[64];
+    snprintf(path, sizeof path, "%s/xch.sock", dir);
+    int lfd = socket(AF_UNIX, SOCK_SEQPACKET, 0);
+    struct sockaddr_un sa = {.sun_family = AF_UNIX};
+    snprintf(sa.sun_path, sizeof sa.sun_path, "%s", path);
+    if (lfd < 0 || bind(lfd, (struct sockaddr *)&sa, sizeof sa) != 0 || listen(lfd, 1) != 0)
+        return 1;
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        close(lfd);
+        _exit(child(path));
+    }
+    agent(lfd);
+    int st = 0;
+    waitpid(pid, &st, 0);
+    if (WIFSIGNALED(st)) {
+        fprintf(stderr, "the client was killed by signal %d%s\n", WTERMSIG(st),
+                WTERMSIG(st) == SIGSYS ? ": it made a call outside the partition policy" : "");
+        failures++;
+    } else {
+        CHECK(WEXITSTATUS(st) == 0);
+        if (WEXITSTATUS(st))
+            fprintf(stderr, "client step %d failed\n", WEXITSTATUS(st));
+    }
+    close(lfd);
+    unlink(path);
+    rmdir(dir);
+    if (failures) {
+        fprintf(stderr, "test_xch_client: %d check(s) failed\n", failures);
+        return 1;
+    }
+    printf("test_xch_client: ok%s\n", SANDBOXED ? " (under the io partition's seccomp filter)" : "");
+    return 0;
+}

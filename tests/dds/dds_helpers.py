@@ -1,0 +1,23 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Helpers of the DDS tests: distinct inputs per node and frame, a lockstep round of exchanges."""
+
+from __future__ import annotations
+
+from ima.dds.xch import Agreed, Inputs, XchClient
+
+
+def inputs_for(node: int, frame: int, wait_mask: int) -> Inputs:
+    """Distinct, checkable inputs of a node for a frame."""
+    return Inputs(valid=0x7, wait_mask=wait_mask, gps_t_ns=frame * 50_000_000 - node,
+                  gps_seq=node * 10_000 + frame, ahrs_seq=frame, air_seq=node,
+                  gps=[47.0 + node / 10, 8.0 + frame / 1000, 3000.0, 100.0, 90.0],
+                  ahrs=[float(node), float(frame)] + [0.5] * 7, air=[100.0, 3000.0, -node * 1.0])
+
+
+def exchange_round(clients: dict[int, XchClient], frame: int, masks: dict[int, int],
+                   timeout: float = 20.0) -> dict[int, Agreed]:
+    """Every client sends its INPUTS for frame (with its wait mask), then collects its AGREED:
+    what the io partitions of lockstep nodes do at a frame start."""
+    for node, c in clients.items():
+        c.send_inputs(frame, frame * 50_000_000, inputs_for(node, frame, masks[node]))
+    return {node: c.await_agreed(frame, timeout) for node, c in clients.items()}

@@ -25,6 +25,7 @@ static void usage(FILE *f)
           "  --stats FILE             JSON statistics at exit ('-' for stdout)\n"
           "  --max-clients N          connected clients at most (64)\n"
           "  --fault KIND:KEY=VAL,... arm a fault (see nodes/README.md); repeatable\n"
+"  --kill-node N@SECONDS    kill every client of node N (hello.node) at that time; repeatable\n"
           "  --bus-off-recovery       clients recover from bus-off after 128 x 11 bit times\n"
           "  --max-rejects N          disconnect a client after N+1 rejected records (100)\n"
           "  --send-timeout-ms MS     stall allowed to a non-lockstep client (2000)\n"
@@ -51,11 +52,22 @@ static int parse_i64(const char *s, int64_t lo, int64_t hi, int64_t *out)
     return 0;
 }
 
+/* parse_i64 of the first n characters of s */
+static int parse_i64_n(const char *s, size_t n, int64_t lo, int64_t hi, int64_t *out)
+{
+    char buf[32];
+    if (n == 0 || n >= sizeof buf)
+        return -1;
+    memcpy(buf, s, n);
+    buf[n] = 0;
+    return parse_i64(buf, lo, hi, out);
+}
+
 int main(int argc, char **argv)
 {
     enum {
         O_SOCKET = 256, O_BITRATE, O_QUANTUM, O_LOCKSTEP, O_DURATION, O_END, O_REALTIME,
-        O_TRACE, O_STATS, O_MAXCL, O_FAULT, O_RECOVER, O_MAXREJ, O_SENDTO, O_CLBUF, O_GAP,
+        O_TRACE, O_STATS, O_MAXCL, O_FAULT, O_RECOVER, O_MAXREJ, O_SENDTO, O_CLBUF, O_GAP, O_KILL,
         O_HELP
     };
     static const struct option longopts[] = {
@@ -70,6 +82,7 @@ int main(int argc, char **argv)
         {"stats", required_argument, NULL, O_STATS},
         {"max-clients", required_argument, NULL, O_MAXCL},
         {"fault", required_argument, NULL, O_FAULT},
+        {"kill-node", required_argument, NULL, O_KILL},
         {"bus-off-recovery", no_argument, NULL, O_RECOVER},
         {"max-rejects", required_argument, NULL, O_MAXREJ},
         {"send-timeout-ms", required_argument, NULL, O_SENDTO},
@@ -147,6 +160,24 @@ int main(int argc, char **argv)
                 o.n_faults++;
             break;
         }
+        case O_KILL: {
+            char *at = strchr(optarg, '@'), *end;
+            double when = at ? strtod(at + 1, &end) : -1;
+            if (!at || at == optarg || parse_i64_n(optarg, (size_t)(at - optarg), 1, 255, &v) ||
+                end == at + 1 || *end || !(when >= 0) || when > 9e9) {
+                bad = "--kill-node must be NODE@SECONDS, e.g. 2@120";
+                break;
+            }
+            canbus_kill_t *k = realloc(o.kills, (o.n_kills + 1) * sizeof *k);
+            if (!k) {
+                bad = "out of memory";
+                break;
+            }
+            o.kills = k;
+            o.kills[o.n_kills++] = (canbus_kill_t){.node = (uint32_t)v,
+                                                   .t_ns = (int64_t)llround(when * 1e9)};
+            break;
+        }
         case O_RECOVER: o.recover = true; break;
         case O_MAXREJ:
             if (parse_i64(optarg, 0, 1000000000, &v))
@@ -175,12 +206,14 @@ int main(int argc, char **argv)
         if (bad) {
             fprintf(stderr, "ima-canbus: %s\n", bad);
             free(o.faults);
+            free(o.kills);
             return EXIT_USAGE;
         }
     }
     if (!o.socket_path || optind != argc) {
         usage(stderr);
         free(o.faults);
+        free(o.kills);
         return EXIT_USAGE;
     }
 
@@ -199,6 +232,7 @@ int main(int argc, char **argv)
     canbus_bus_t *b = calloc(1, sizeof *b);
     if (!b) {
         free(o.faults);
+        free(o.kills);
         return 1;
     }
     int rc = canbus_bus_open(b, &o);
@@ -207,6 +241,7 @@ int main(int argc, char **argv)
                 strerror(-rc));
         free(b);
         free(o.faults);
+        free(o.kills);
         return 1;
     }
     rc = canbus_bus_run(b);
@@ -225,5 +260,6 @@ int main(int argc, char **argv)
     }
     free(b);
     free(o.faults);
+    free(o.kills);
     return status;
 }

@@ -554,6 +554,10 @@ static void accept_all(canbus_bus_t *b)
         }
         c->fd = fd;
         c->index = -1;
+        struct ucred cred;
+        socklen_t len = sizeof cred;
+        if (getsockopt(fd, SOL_SOCKET, SO_PEERCRED, &cred, &len) == 0)
+            c->pid = cred.pid;
         b->live[b->n_live++] = c;
     }
 }
@@ -768,6 +772,39 @@ static void wait_queues(canbus_bus_t *b)
     }
 }
 
+/* --kill-node: kills the processes of every client of the node and drops them, at the start
+ * of the quantum b->t (all of them are waiting for it: nothing they do is half done). */
+static void apply_kills(canbus_bus_t *b)
+{
+    for (size_t k = 0; k < b->o.n_kills; k++) {
+        canbus_kill_t *kill_req = &b->o.kills[k];
+        if (kill_req->done || kill_req->t_ns > b->t)
+            continue;
+        kill_req->done = true;
+        canbus_sbuf_t *s = &b->line;
+        line_head(s, b->t, "node_kill");
+        canbus_sb_str(s, ",\"killed_node\":");
+        canbus_sb_u64(s, kill_req->node);
+        canbus_sb_str(s, ",\"clients\":[");
+        bool first = true;
+        for (size_t i = 0; i < b->n_live; i++) {
+            canbus_client_t *c = b->live[i];
+            if (c->gone || c->index < 0 || c->node != kill_req->node)
+                continue;
+            if (c->pid > 0)
+                kill(c->pid, SIGKILL);
+            if (!first)
+                canbus_sb_str(s, ",");
+            first = false;
+            canbus_sb_json_str(s, c->name, sizeof c->name);
+            client_leave(b, c, "node_killed");
+        }
+        canbus_sb_str(s, "]}\n");
+        trace_write(b, s);
+        info(b, "node %u killed at t=%" PRId64 " ns", kill_req->node, b->t);
+    }
+}
+
 static int write_wire_trace(canbus_bus_t *b)
 {
     canbus_wire_t *w = &b->wire;
@@ -799,6 +836,8 @@ int canbus_bus_run(canbus_bus_t *b)
         wait_queues(b);
         if (b->stopping)
             break;
+        apply_kills(b);
+        flush_staged(b);
         if ((rc = deliver(b, b->t, true)))
             break;
         while (!b->stopping && pending_done(b) > 0)

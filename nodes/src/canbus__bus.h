@@ -9,6 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <sys/types.h>
 
 #include "canbus/proto.h"
 #include "canbus__wire.h"
@@ -35,6 +36,15 @@ typedef struct canbus_cli_fault {
     char target_name[CANBUS_NAME_LEN + 1];
 } canbus_cli_fault_t;
 
+/* --kill-node: at the first quantum starting at or after t_ns, every client of `node` is
+ * killed (SIGKILL to the peer process) and dropped: the processor stops at a deterministic
+ * instant, with every window before it finished (its SKE had sent DONE). */
+typedef struct canbus_kill {
+    uint32_t node;
+    int64_t t_ns;
+    bool done;
+} canbus_kill_t;
+
 typedef struct canbus_opts {
     const char *socket_path;
     uint32_t bitrate;
@@ -53,11 +63,14 @@ typedef struct canbus_opts {
     uint32_t gap_bits;      /* idle bits added after each frame (0: the formula's 3-bit IFS) */
     canbus_cli_fault_t *faults;
     size_t n_faults;
+    canbus_kill_t *kills;
+    size_t n_kills;
 } canbus_opts_t;
 
 typedef struct canbus_client {
     int fd;
     int index; /* -1 until welcomed */
+    pid_t pid; /* peer process (SO_PEERCRED), 0 if unknown */
     uint16_t roles;
     uint32_t node;
     char name[CANBUS_NAME_LEN + 1];

@@ -10,6 +10,17 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 PILOTS = ROOT / "sim" / "pilots"
 
+# The single-node flight's bounds in light turbulence (judged on the truth over the holds);
+# a redundant system must fly within the same ones.
+LIGHT_BOUNDS = {"alt_err_ft_rms": 12, "alt_err_ft_max": 60, "airspeed_err_kt_rms": 6,
+                "airspeed_err_kt_max": 20, "heading_err_deg_rms": 3, "heading_err_deg_max": 12}
+
+
+def within(summary: dict, bounds: dict) -> list[str]:
+    """The bounds a summary breaks (an unjudged value breaks its bound too)."""
+    return [f"{k} = {summary.get(k)} > {v}" for k, v in bounds.items()
+            if summary.get(k) is None or summary[k] > v]
+
 
 def mission_node_module(dest: Path, feed_args: str) -> Path:
     """The flight node plus a stand-in mission manager (partition mission_feed) writing

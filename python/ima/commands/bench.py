@@ -32,6 +32,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     fl.add_argument("--json", action="store_true", help="print the results as JSON")
     fl.add_argument("--duration", type=positive_int, default=600, metavar="SECONDS",
                     help="emulated flight time (default 600)")
+    tri = targets.add_parser(
+        "triplex", help="the triplex system: speed-up of a 10-minute flight of 3 nodes, "
+        "node-to-node DDS latency next to ddsperf's, peak memory")
+    tri.add_argument("--json", action="store_true", help="print the results as JSON")
+    tri.add_argument("--duration", type=positive_int, default=600, metavar="SECONDS",
+                     help="emulated flight time (default 600)")
     return parser
 
 
@@ -44,4 +50,8 @@ def run(args: argparse.Namespace) -> int:
         from ima.bench import flight
 
         return flight.run(json_out=args.json, duration_s=float(args.duration)) or 0
+    if args.target == "triplex":
+        from ima.bench import triplex
+
+        return triplex.run(json_out=args.json, duration_s=float(args.duration)) or 0
     raise AssertionError(f"unhandled bench target {args.target}")  # argparse restricts it

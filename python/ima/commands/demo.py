@@ -1,25 +1,29 @@
 # SPDX-License-Identifier: Apache-2.0
-"""`ima demo`: flies the default 10-minute mission of one emulated processor (world, CAN bus,
-io + nav_fcs partitions) and prints the flight summary."""
+"""`ima demo`: launches the triplex system (config/systems/rpas_triplex.yaml: three emulated
+processors, voted flight control) on the default 10-minute mission and prints the summary."""
 
 from __future__ import annotations
 
 import argparse
 
-from ima.commands import fly
+from ima.commands import launch
+from ima.paths import repo_root
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         "demo",
-        help="fly the default 10-minute autopilot mission and print the flight summary",
-        description="Fly sim/pilots/default.yaml (hold, a 90° turn, a 1000 ft climb) with one "
-        "ARINC 653 processor over the virtual CAN bus in light turbulence and a 10 kt wind, "
-        "and print the summary judged from the world's truth trace. Same options as `ima fly`.",
+        help="launch the triplex on the default 10-minute autopilot mission and print the summary",
+        description="Launch config/systems/rpas_triplex.yaml (three ARINC 653 processors, each "
+        "with the io and nav_fcs partitions and a DDS agent; the smart actuators vote over the "
+        "three flight-control replicas) on sim/pilots/default.yaml (hold, a 90° turn, a 1000 ft "
+        "climb) in light turbulence and a 10 kt wind, and print the summary judged from the "
+        "world's truth trace. Same options as `ima launch`, e.g. --kill-node node2@120.",
     )
-    fly.add_flight_arguments(parser)
+    launch.add_launch_arguments(parser)
     return parser
 
 
 def run(args: argparse.Namespace) -> int:
-    return fly.run(args)
+    args.system = repo_root() / "config" / "systems" / "rpas_triplex.yaml"
+    return launch.run(args)

@@ -93,15 +93,22 @@ def fly_and_summarise(opts: flight.FlightOptions, json_out: bool) -> int:
                                        nodes=opts.nodes, plot=True)
     summary["returncodes"] = result.returncodes
     failed = {k: v for k, v in result.returncodes.items() if v not in (0, None)}
+    return report(summary, failed, result.run_dir, result.interrupted, json_out, console,
+                  print_summary)
+
+
+def report(summary: dict, failed: dict, run_dir: Path, interrupted: bool, json_out: bool,
+           console, printer) -> int:
+    """Ends a run: the summary (JSON on stdout, or printed), then Ctrl-C or a failure."""
     if json_out:
         json.dump(summary, sys.stdout)
         sys.stdout.write("\n")
     else:
-        print_summary(summary, console)
-    if result.interrupted:
+        printer(summary, console)
+    if interrupted:
         raise KeyboardInterrupt
     if failed:
-        raise ImaError(f"flight processes failed: {failed} (logs in {result.run_dir})")
+        raise ImaError(f"processes failed: {failed} (logs in {run_dir})")
     return 0
 
 

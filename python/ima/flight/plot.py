@@ -9,7 +9,9 @@ from pathlib import Path
 from ima.flight.summary import HoldSegment
 
 
-def plot_flight(truth: list[dict], segments: list[HoldSegment], out: Path, title: str) -> Path:
+def plot_flight(truth: list[dict], segments: list[HoldSegment], out: Path, title: str,
+                events: list[tuple[float, str]] | None = None) -> Path:
+    """`events`: (time s, label) marked on every panel, e.g. a node killed, a replica voted out."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -27,8 +29,20 @@ def plot_flight(truth: list[dict], segments: list[HoldSegment], out: Path, title
             if target:
                 ax.hlines(getattr(seg, target), seg.t0_s, seg.t1_s, colors="tab:red", lw=1.0,
                           linestyles="dashed", label="target" if k == 0 else None)
+        for te, _text in events or []:
+            ax.axvline(te, color="tab:purple", lw=0.8, ls="--", alpha=0.7)
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
+    # one label per cluster of events (close events would print over each other)
+    labels: list[list] = []
+    for te, text in sorted(events or []):
+        if labels and t and te - labels[-1][0] < 0.02 * (t[-1] - t[0]):
+            labels[-1][1] += "; " + text
+        else:
+            labels.append([te, text])
+    for te, text in labels:
+        axes[0].annotate(text, (te, 0.98), xycoords=("data", "axes fraction"), fontsize=7,
+                         color="tab:purple", rotation=90, va="top", ha="right")
     axes[-1].axhline(30, color="tab:red", lw=0.6, ls=":")
     axes[-1].axhline(-30, color="tab:red", lw=0.6, ls=":")
     axes[0].legend(loc="upper left", fontsize=8)

@@ -218,6 +218,21 @@ def _watch(procs: _Procs, world: subprocess.Popen, run_dir: Path) -> None:
         time.sleep(0.2)
 
 
+def follow_world(world: subprocess.Popen, on_status: Callable[[dict], None] | None) -> None:
+    """Passes the world's status lines (JSON objects on its stdout) on until it exits."""
+    assert world.stdout is not None
+    for line in world.stdout:
+        if on_status is None:
+            continue
+        try:
+            status = json.loads(line)
+        except ValueError:
+            continue
+        if isinstance(status, dict):
+            on_status(status)
+    world.wait()
+
+
 def fly(opts: FlightOptions, on_status: Callable[[dict], None] | None = None) -> FlightRun:
     """Runs the flight to its end (or Ctrl-C); the caller summarises the run directory."""
     if opts.turbulence not in TURBULENCE:
@@ -290,16 +305,7 @@ def fly(opts: FlightOptions, on_status: Callable[[dict], None] | None = None) ->
         assert world.stdout is not None
         watchdog = threading.Thread(target=_watch, args=(procs, world, run_dir), daemon=True)
         watchdog.start()
-        for line in world.stdout:
-            if on_status is None:
-                continue
-            try:
-                status = json.loads(line)
-            except ValueError:
-                continue
-            if isinstance(status, dict):
-                on_status(status)
-        world.wait()
+        follow_world(world, on_status)
         # The world has stopped: the bus ends the run within a quantum; then the nodes.
         deadline = time.monotonic() + _GRACE_S
         for proc in procs.procs.values():

@@ -144,9 +144,10 @@ def hm_events(node_trace: Path) -> list[dict]:
 
 
 def summarise(run_dir: Path, pilot: Path, duration_s: float, wall_s: float | None = None,
-              nodes: int = 1, plot: bool = False) -> dict[str, Any]:
+              nodes: int = 1, plot: bool = False,
+              events: list[tuple[float, str]] | None = None) -> dict[str, Any]:
     """The flight's summary (also written to RUN_DIR/summary.json); `plot` also draws
-    RUN_DIR/flight.png."""
+    RUN_DIR/flight.png, with `events` (time s, label) marked."""
     truth_path = run_dir / "truth.jsonl"
     truth = list(read_jsonl(truth_path))
     world = _read_json(run_dir / "world.json")
@@ -183,6 +184,6 @@ def summarise(run_dir: Path, pilot: Path, duration_s: float, wall_s: float | Non
         from ima.flight.plot import plot_flight
 
         summary["plot"] = str(plot_flight(truth, segments, run_dir / "flight.png",
-                                          f"{pilot.name}, {run_dir.name}"))
+                                          f"{pilot.name}, {run_dir.name}", events))
     (run_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     return summary

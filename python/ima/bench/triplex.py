@@ -1,0 +1,80 @@
+# SPDX-License-Identifier: Apache-2.0
+"""`ima bench triplex`: the redundant system at work.
+
+- speedup: emulated seconds per wall second of a 10-minute flight of
+  config/systems/rpas_triplex.yaml (3 nodes, each an SKE with its partitions and a DDS agent,
+  the CAN bus, the world), in emulated time;
+- peak_rss_mb: the peak of the summed resident memory of every process of that run;
+- dds_latency_us_median: node-to-node latency through two of the product's DDS agents in
+  real-time mode, next to ddsperf_latency_us_median measured in the same run with ddsperf on
+  the same Cyclone configuration (ima.bench.dds says how each is measured)."""
+
+from __future__ import annotations
+
+import json
+import tempfile
+import time
+from pathlib import Path
+
+from ima import paths
+from ima.bench.flight import RssSampler
+from ima.errors import ImaError
+from ima.launch import run as launch_run
+
+TARGETS = {"speedup": 20.0, "latency_ratio": 2.0, "peak_rss_mb": 600.0}
+
+
+def default_system() -> Path:
+    return paths.repo_root() / "config" / "systems" / "rpas_triplex.yaml"
+
+
+def run(json_out: bool, duration_s: float = 600.0, seed: int = 1,
+        system: Path | None = None) -> int:
+    from rich.console import Console
+
+    from ima.bench import dds as dds_bench
+
+    console = Console(stderr=True)
+    results: dict = {}
+    with tempfile.TemporaryDirectory(prefix="ima-bench-triplex-") as tmp:
+        opts = launch_run.LaunchOptions(system=system or default_system(), duration_s=duration_s,
+                                        seed=seed, run_dir=Path(tmp) / "run")
+        with console.status(f"flying the triplex {duration_s:g} s (seed {seed})"):
+            with RssSampler() as rss:
+                t0 = time.monotonic()
+                result = launch_run.launch(opts)
+                wall = time.monotonic() - t0
+        failed = {k: v for k, v in result.returncodes.items() if v not in (0, None)}
+        if failed:
+            raise ImaError(f"benchmark run failed: {failed}")
+        truth = (result.run_dir / "truth.jsonl").read_text().splitlines()
+        flown = json.loads(truth[-1])["t_ns"] / 1e9 if truth else 0.0
+        results["nodes"] = len(result.nodes)
+        results["flight_s"] = round(flown, 1)
+        results["wall_s"] = round(wall, 2)
+        results["speedup"] = round(flown / wall, 1)
+        results["peak_rss_mb"] = round(rss.peak / 2**20, 1)
+    with console.status("DDS latency: two agents in real time, then ddsperf"):
+        lat = dds_bench.measure()
+    results["dds_latency_us_median"] = lat.get("dds_latency_us_median")
+    results["ddsperf_latency_us_median"] = lat.get("ddsperf_latency_us_median")
+    ours, ref = results["dds_latency_us_median"], results["ddsperf_latency_us_median"]
+    results["latency_ratio"] = round(ours / ref, 2) if ours and ref else None
+    results["dds_bench"] = lat
+    results["targets_met"] = {
+        "speedup": results["speedup"] >= TARGETS["speedup"],
+        "dds_latency": results["latency_ratio"] is not None
+        and results["latency_ratio"] <= TARGETS["latency_ratio"],
+        "peak_rss_mb": results["peak_rss_mb"] < TARGETS["peak_rss_mb"],
+    }
+    if json_out:
+        print(json.dumps(results))
+    else:
+        out = Console()
+        out.print(f"triplex flight: {results['flight_s']:.0f} s emulated in {results['wall_s']:.1f} s "
+                  f"wall → speed-up ×{results['speedup']:.0f} (target ≥ {TARGETS['speedup']:.0f})")
+        out.print(f"node-to-node DDS latency: median {ours} µs; ddsperf on the same config: "
+                  f"{ref} µs (target ≤ {TARGETS['latency_ratio']:g}×)")
+        out.print(f"peak memory of the whole run: {results['peak_rss_mb']:.0f} MB "
+                  f"(target < {TARGETS['peak_rss_mb']:.0f})")
+    return 0

@@ -1,0 +1,99 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Judges a launched system: the flight (as `ima fly` does, from the world's truth), plus what
+the redundancy did: which replicas the actuators voted out and when, the node membership the
+nodes agreed on, the nodes' self-monitor reports, the DDS agents' view."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from ima.flight import summary as flight_summary
+from ima.flight.summary import read_jsonl
+
+MEMBERSHIP_PREFIX = "membership "
+MONITOR_PREFIX = "cross-channel monitor: "
+
+
+def parse_members(text: str) -> list[str]:
+    """'membership node1,node3 (lost node2)' -> ['node1', 'node3']."""
+    body = text[len(MEMBERSHIP_PREFIX):].split(" (")[0].strip()
+    return [m for m in body.split(",") if m]
+
+
+def node_reports(run_dir: Path, node: str) -> dict[str, list[dict]]:
+    """The io partition's membership changes and self-monitor reports in a node's trace."""
+    membership, monitor = [], []
+    for rec in read_jsonl(run_dir / f"{node}.jsonl"):
+        if rec.get("kind") != "app_message":
+            continue
+        text = rec.get("text", "")
+        if text.startswith(MEMBERSHIP_PREFIX):
+            membership.append({"t_s": round(rec["t_ns"] / 1e9, 3), "node": node,
+                               "members": parse_members(text)})
+        elif text.startswith(MONITOR_PREFIX):
+            monitor.append({"t_s": round(rec["t_ns"] / 1e9, 3), "node": node,
+                            "text": text[len(MONITOR_PREFIX):]})
+    return {"membership": membership, "monitor": monitor}
+
+
+def voting(run_dir: Path) -> dict[str, Any]:
+    """The actuators' voting, from the world's trace."""
+    voted_out, changes = [], []
+    for rec in read_jsonl(run_dir / "world.jsonl"):
+        kind = rec.get("kind")
+        if kind == "voted_out":
+            voted_out.append({"node": rec.get("node"), "t_s": round(rec["t_ns"] / 1e9, 3),
+                              "channel": rec.get("channel"), "reason": rec.get("reason")})
+        elif kind == "vote":
+            changes.append({k: rec.get(k) for k in ("status", "used")}
+                           | {"t_s": round(rec["t_ns"] / 1e9, 3)})
+    return {"voted_out": voted_out, "vote_changes": changes,
+            "vote_status": changes[-1]["status"] if changes else None}
+
+
+def _dds_stats(run_dir: Path, node_index: int) -> dict | None:
+    path = run_dir / f"dds{node_index}.json"
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def summarise(run_dir: Path, pilot: Path, duration_s: float, nodes: list[str],
+              killed: dict[str, float], wall_s: float | None = None,
+              plot: bool = False) -> dict[str, Any]:
+    """The run's summary (also written to RUN_DIR/summary.json)."""
+    vote = voting(run_dir)
+    events = [(t, f"{k} stopped") for k, t in killed.items()]
+    events += [(v["t_s"], f"{v['node']} voted out") for v in vote["voted_out"]]
+    summary = flight_summary.summarise(run_dir, pilot, duration_s, wall_s, nodes=len(nodes),
+                                       plot=plot, events=sorted(events))
+    summary["nodes"] = list(nodes)
+    summary["killed"] = [{"node": k, "t_s": t} for k, t in sorted(killed.items())]
+    summary.update(vote)
+    views: dict[str, list[str]] = {}
+    membership_events, monitor = [], []
+    for node in nodes:
+        rep = node_reports(run_dir, node)
+        membership_events += rep["membership"]
+        monitor += rep["monitor"]
+        views[node] = rep["membership"][-1]["members"] if rep["membership"] else list(nodes)
+    # The membership the live nodes agree on (a killed node's last view is not a vote).
+    live_views = {n: v for n, v in views.items() if n not in killed}
+    agreed = sorted({tuple(v) for v in live_views.values()})
+    summary["membership"] = list(agreed[0]) if len(agreed) == 1 else None
+    summary["membership_agreed"] = len(agreed) == 1
+    summary["membership_views"] = views
+    summary["membership_events"] = sorted(membership_events, key=lambda e: (e["t_s"], e["node"]))
+    summary["monitor_reports"] = sorted(monitor, key=lambda e: (e["t_s"], e["node"]))
+    dds = {}
+    for k, node in enumerate(nodes, start=1):
+        st = _dds_stats(run_dir, k)
+        if st is not None:
+            dds[node] = st
+    if dds:
+        summary["dds"] = dds
+    (run_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    return summary

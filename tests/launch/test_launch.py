@@ -139,3 +139,40 @@ def test_missing_system_file_is_a_clear_error(tmp_path):
     proc = subprocess.run([IMA, "launch", str(tmp_path / "nope.yaml")], capture_output=True,
                           text=True, timeout=120)
     assert proc.returncode != 0 and "nope.yaml" in proc.stderr and "Traceback" not in proc.stderr
+
+
+@pytest.mark.skipif(os.geteuid() != 0 or not Path("/usr/sbin/ip").exists() and not Path("/sbin/ip").exists(),
+                    reason="network namespaces need root and iproute2")
+def test_netns_puts_each_node_in_its_own_namespace(launches):
+    def namespaces() -> set[str]:
+        out = subprocess.run(["ip", "netns", "list"], capture_output=True, text=True).stdout
+        return {line.split()[0] for line in out.splitlines() if line.strip()}
+
+    before = namespaces()
+    seen: dict = {}
+    run_dir = launches.base / "netns"
+
+    def on_status(st: dict) -> None:
+        if not seen and st.get("t_s", 0) > 5:
+            seen["ns"] = namespaces() - before
+            seen["pids"] = _run_pids(str(run_dir))
+            node_ns = seen["node_ns"] = {}
+            for pid, cmd in seen["pids"].items():
+                if "ima-dds-node" in cmd or "ima-ske" in cmd:
+                    try:
+                        node_ns[pid] = os.readlink(f"/proc/{pid}/ns/net")
+                    except OSError:
+                        pass
+
+    run = launches.launch("netns", duration_s=20.0, seed=SEED, netns=True, on_status=on_status)
+    assert len(seen["ns"]) == 3, seen
+    # the agents found each other across the bridge, and voting ran on three replicas
+    for node in ("node1", "node2", "node3"):
+        peers = run.summary["dds"][node]["peers"]
+        assert all(p["discovered"] and p["alive"] for p in peers), peers
+    assert run.summary["vote_status"] == "MID3" and run.summary["voted_out"] == []
+    # each node's processes were in a namespace of their own
+    own = {os.readlink("/proc/self/ns/net")}
+    node_ns = set(seen["node_ns"].values())
+    assert len(seen["node_ns"]) == 6 and len(node_ns) == 3 and not node_ns & own, seen
+    assert namespaces() == before, "namespaces left behind"

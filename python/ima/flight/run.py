@@ -166,24 +166,31 @@ def _wait_for_socket(path: Path, bus: subprocess.Popen, log: Path, timeout: floa
         time.sleep(0.005)
 
 
-def _bus_connections(sock: Path) -> int:
+def _bus_connections(sock: Path, pids: tuple[int, ...] = ()) -> int:
     """Connections made to the bus on `sock` (their bus side appears in /proc/net/unix under
-    its path as soon as the client has connected, accepted or not)."""
+    its path as soon as the client has connected, accepted or not). A client in another
+    network namespace has its connection listed in that namespace's table: `pids` are
+    processes whose namespaces to read too."""
     name = os.fsencode(sock)
-    try:
-        with open("/proc/net/unix", "rb") as f:
-            lines = f.read().splitlines()[1:]
-    except OSError:
-        return 0
-    # the listening socket has flag __SO_ACCEPTCON (00010000); accepted ones do not
-    return sum(1 for ln in lines if ln.endswith(b" " + name) and ln.split()[3] != b"00010000")
+    inodes = set()
+    for table in ("/proc/net/unix", *(f"/proc/{pid}/net/unix" for pid in pids)):
+        try:
+            with open(table, "rb") as f:
+                lines = f.read().splitlines()[1:]
+        except OSError:
+            continue
+        # the listening socket has flag __SO_ACCEPTCON (00010000); accepted ones do not
+        inodes.update(ln.split()[6] for ln in lines
+                      if ln.endswith(b" " + name) and ln.split()[3] != b"00010000")
+    return len(inodes)
 
 
-def _wait_joined(sock: Path, count: int, procs: _Procs, timeout: float = 10.0) -> None:
+def _wait_joined(sock: Path, count: int, procs: _Procs, timeout: float = 10.0,
+                 pids: tuple[int, ...] = ()) -> None:
     """Waits until `count` clients are connected, so clients join in a fixed order (the bus
     numbers them by arrival, and the numbers are in its trace)."""
     deadline = time.monotonic() + timeout
-    while _bus_connections(sock) < count:
+    while _bus_connections(sock, pids) < count:
         for name, proc in procs.procs.items():
             if proc.poll() is not None:
                 raise ImaError(f"{name} exited ({proc.returncode}) before joining the bus")

@@ -58,6 +58,7 @@ class Namespaces:
         self.host_if = {n: f"v{tag}n{k}" for k, n in enumerate(nodes, start=1)}
         self.addr = {n: f"{self.subnet}.{k}" for k, n in enumerate(nodes, start=1)}
         self.created: list[str] = []
+        self.device = "veth0"  # the node's interface in its namespace
 
     def create(self) -> None:
         try:

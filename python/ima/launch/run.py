@@ -314,16 +314,21 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
             node = name.split("/")[0]
             if netns is not None:
                 cfg = netns.dds_config(node, run_dir)
-                cmd = netns.wrap(node, [c if c != str(dds_cfg) else str(cfg) for c in cmd])
+                cmd = netns.wrap(node, [c if c != str(dds_cfg) else str(cfg) for c in cmd]
+                                 + ["--bind-device", netns.device])
             agents[name] = procs.start(name, cmd, run_dir / _log(name),
                                        env=env, stdout=subprocess.PIPE)
         _wait_ready(agents, run_dir)
+        netns_pids: list[int] = []
         for k, node in enumerate(names, start=1):
             cmd = node_cmds[node]
             if netns is not None:
                 cmd = netns.wrap(node, cmd)
-            procs.start(node, cmd, run_dir / f"{node}.log", env=dict(base_env, **node_env[node]))
-            flight._wait_joined(sock, k, procs)
+            proc = procs.start(node, cmd, run_dir / f"{node}.log",
+                               env=dict(base_env, **node_env[node]))
+            if netns is not None:
+                netns_pids.append(proc.pid)
+            flight._wait_joined(sock, k, procs, pids=tuple(netns_pids))
         world = procs.start("world", world_cmd, run_dir / "world.log", env=base_env,
                             stdout=subprocess.PIPE)
         watch = _NodeWatch(procs, world, run_dir, kills)

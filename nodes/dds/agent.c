@@ -324,9 +324,22 @@ static void run(agent_t *a)
     }
 }
 
+/* A launcher may start us with stdin or stdout closed: keep descriptors 0..2 taken, so that
+ * no socket or trace file becomes "stdout" and receives the ready line. */
+static void hold_std_fds(void)
+{
+    for (int fd = 0; fd <= 2; fd++)
+        if (fcntl(fd, F_GETFD) == -1 && errno == EBADF) {
+            int n = open("/dev/null", O_RDWR);
+            if (n >= 0 && n != fd)
+                close(n); /* not the lowest free descriptor after all */
+        }
+}
+
 int main(int argc, char **argv)
 {
     static agent_t agent;
+    hold_std_fds();
     agent_t *a = &agent;
     a->listen_fd = a->io_fd = a->sig_fd = a->wake_rd = a->wake_wr = -1;
     if (parse_args(argc, argv, &a->o) != 0)

@@ -67,7 +67,7 @@ typedef struct {
 } agent_peer_t;
 
 typedef struct {
-    uint64_t written, read, invalid, write_errors, own;
+    uint64_t written, read, invalid, write_errors;
 } agent_topic_stats_t;
 
 /* Latency samples of the exchange, request to AGREED, in ns. */

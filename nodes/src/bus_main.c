@@ -26,6 +26,7 @@ static void usage(FILE *f)
           "  --max-clients N          connected clients at most (64)\n"
           "  --fault KIND:KEY=VAL,... arm a fault (see nodes/README.md); repeatable\n"
 "  --kill-node N@SECONDS    kill every client of node N (hello.node) at that time; repeatable\n"
+          "  --client-order A,B,...   client indices by name (deterministic for racy joins)\n"
           "  --bus-off-recovery       clients recover from bus-off after 128 x 11 bit times\n"
           "  --max-rejects N          disconnect a client after N+1 rejected records (100)\n"
           "  --send-timeout-ms MS     stall allowed to a non-lockstep client (2000)\n"
@@ -67,7 +68,7 @@ int main(int argc, char **argv)
 {
     enum {
         O_SOCKET = 256, O_BITRATE, O_QUANTUM, O_LOCKSTEP, O_DURATION, O_END, O_REALTIME,
-        O_TRACE, O_STATS, O_MAXCL, O_FAULT, O_RECOVER, O_MAXREJ, O_SENDTO, O_CLBUF, O_GAP, O_KILL,
+        O_TRACE, O_STATS, O_MAXCL, O_FAULT, O_RECOVER, O_MAXREJ, O_SENDTO, O_CLBUF, O_GAP, O_KILL, O_ORDER,
         O_HELP
     };
     static const struct option longopts[] = {
@@ -83,6 +84,7 @@ int main(int argc, char **argv)
         {"max-clients", required_argument, NULL, O_MAXCL},
         {"fault", required_argument, NULL, O_FAULT},
         {"kill-node", required_argument, NULL, O_KILL},
+        {"client-order", required_argument, NULL, O_ORDER},
         {"bus-off-recovery", no_argument, NULL, O_RECOVER},
         {"max-rejects", required_argument, NULL, O_MAXREJ},
         {"send-timeout-ms", required_argument, NULL, O_SENDTO},
@@ -178,6 +180,25 @@ int main(int argc, char **argv)
                                                    .t_ns = (int64_t)llround(when * 1e9)};
             break;
         }
+        case O_ORDER: {
+            /* names point into argv; the separators become NULs */
+            o.n_order = 0;
+            free(o.order);
+            o.order = calloc(CANBUS_WIRE_MAX_CLIENTS, sizeof *o.order);
+            if (!o.order) {
+                bad = "out of memory";
+                break;
+            }
+            for (char *save = NULL, *tok = strtok_r(optarg, ",", &save); tok;
+                 tok = strtok_r(NULL, ",", &save)) {
+                if (o.n_order >= 64 || strlen(tok) > CANBUS_NAME_LEN) {
+                    bad = "--client-order: at most 64 names of at most 32 characters";
+                    break;
+                }
+                o.order[o.n_order++] = tok;
+            }
+            break;
+        }
         case O_RECOVER: o.recover = true; break;
         case O_MAXREJ:
             if (parse_i64(optarg, 0, 1000000000, &v))
@@ -207,6 +228,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "ima-canbus: %s\n", bad);
             free(o.faults);
             free(o.kills);
+            free(o.order);
             return EXIT_USAGE;
         }
     }
@@ -214,6 +236,7 @@ int main(int argc, char **argv)
         usage(stderr);
         free(o.faults);
         free(o.kills);
+        free(o.order);
         return EXIT_USAGE;
     }
 
@@ -233,6 +256,7 @@ int main(int argc, char **argv)
     if (!b) {
         free(o.faults);
         free(o.kills);
+        free(o.order);
         return 1;
     }
     int rc = canbus_bus_open(b, &o);
@@ -242,6 +266,7 @@ int main(int argc, char **argv)
         free(b);
         free(o.faults);
         free(o.kills);
+        free(o.order);
         return 1;
     }
     rc = canbus_bus_run(b);
@@ -261,5 +286,6 @@ int main(int argc, char **argv)
     free(b);
     free(o.faults);
     free(o.kills);
+    free(o.order);
     return status;
 }

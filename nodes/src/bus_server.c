@@ -344,7 +344,14 @@ static void handle_hello(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p, 
         refuse(b, c, CANBUS_STOP_FULL, "full");
         return;
     }
-    c->index = b->next_index++;
+    c->index = -1;
+    for (size_t k = 0; k < b->o.n_order; k++)
+        if (!b->by_index[k] && strcmp(b->o.order[k], c->name) == 0) {
+            c->index = (int)k; /* its place in --client-order */
+            break;
+        }
+    if (c->index < 0)
+        c->index = b->next_index++;
     c->roles = h.roles;
     c->node = h.node;
     b->by_index[c->index] = c;
@@ -899,6 +906,7 @@ int canbus_bus_open(canbus_bus_t *b, const canbus_opts_t *o)
     int rc;
     memset(b, 0, sizeof *b);
     b->o = *o;
+    b->next_index = (int)o->n_order; /* clients not in --client-order come after its places */
     b->listen_fd = -1;
     b->stop_reason = CANBUS_STOP_END;
     if ((rc = canbus_wire_init(&b->wire, o->bitrate, o->gap_bits)))
@@ -992,6 +1000,8 @@ int canbus_bus_write_stats(canbus_bus_t *b, const char *path)
     for (int i = 0; i < b->next_index; i++) {
         const canbus_client_t *c = b->by_index[i];
         const canbus_wire_ctl_t *k = &w->ctl[i];
+        if (!c)
+            continue; /* a --client-order place nobody took */
         fprintf(f,
                 "%s{\"index\":%d,\"name\":%.*s,\"roles\":%u,\"tx\":%" PRIu64 ",\"rx\":%" PRIu64
                 ",\"rejected\":%" PRIu64 ",\"clamped\":%" PRIu64 ",\"overflow\":%" PRIu64
@@ -1027,6 +1037,8 @@ void canbus_bus_close(canbus_bus_t *b)
         }
     for (int i = 0; i < b->next_index; i++) {
         canbus_client_t *c = b->by_index[i];
+        if (!c)
+            continue;
         free(c->q);
         canbus_sb_free(&c->staged);
         canbus_sb_free(&c->jname);

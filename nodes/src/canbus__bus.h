@@ -65,6 +65,11 @@ typedef struct canbus_opts {
     size_t n_faults;
     canbus_kill_t *kills;
     size_t n_kills;
+    /* --client-order: the client named order[k] gets index k, whenever it joins; others get
+     * the indices after. Clients that join in the same quantum in a racy order (each node's
+     * io partition) so get the same indices in every run. */
+    char **order;
+    size_t n_order;
 } canbus_opts_t;
 
 typedef struct canbus_client {

@@ -54,3 +54,24 @@ def test_listener_text_output_and_timeout(agents, connect, domain):
     # the mission sample is retained by its writer (transient local): the listener gets it
     assert "rpas_MissionData node1 frame 3" in p.stdout and "alt_ft=3000" in p.stdout
     assert p.returncode == 1  # fewer than --count samples before the timeout
+
+
+def test_listener_reports_instance_state_changes(agents, connect, domain):
+    """An io link that drops disposes its node's inputs; an agent that ends leaves no writers."""
+    ags = agents(2)
+    c1, c2 = connect(ags[0]), connect(ags[1])
+    listener = subprocess.Popen(
+        [sys.executable, "-m", "ima.dds.listen", "--domain", str(domain), "--topic",
+         "rpas_CrossChannelInputs", "--count", "4", "--timeout", "30", "--json"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=dds_env())
+    time.sleep(1.0)  # matched by then
+    for c in (c1, c2):
+        c.exchange(0, 0, xch.Inputs(valid=1, wait_mask=0), timeout=5)  # waits for nobody
+    c1.close()  # node 1's io goes: its agent disposes node 1's inputs
+    time.sleep(0.2)
+    ags[1].stop()  # node 2's agent ends: its writer goes
+    out, err = listener.communicate(timeout=40)
+    assert listener.returncode == 0, err
+    got = {(e.get("node") or e["sample"]["node"], e.get("instance_state", "valid"))
+           for e in map(json.loads, out.splitlines())}
+    assert got == {(1, "valid"), (1, "disposed"), (2, "valid"), (2, "no_writers")}

@@ -68,9 +68,10 @@ def test_no_multicast_group_joined_off_loopback(agents):
     ags = agents(2)
     with open(f"/proc/{ags[0].pid}/net/igmp") as f:
         text = f.read()
-    # the kernel's own all-hosts group at most, on every interface
+    # the kernel's own groups at most (all hosts; all snoopers on a bridge)
     groups = [line.split()[0] for line in text.splitlines() if line.startswith("\t")]
-    assert set(groups) <= {"010000E0"}, text
+    assert set(groups) <= netcheck.KERNEL_GROUPS_V4, text
+    assert "0100FFEF" not in text  # Cyclone's default discovery group 239.255.0.1
 
 
 def test_a_dead_pid_is_a_problem():
@@ -83,3 +84,13 @@ def test_a_dead_pid_is_a_problem():
 def test_unknown_device(device):
     assert netcheck.check_loopback_only([os.getpid()], device=device) == [
         f"no interface {device}"]
+
+
+def test_route_localnet_is_reported(tmp_path, monkeypatch):
+    for dev, val in (("lo", "1"), ("default", "1"), ("eth0", "1"), ("eth1", "0")):
+        (tmp_path / dev).mkdir()
+        (tmp_path / dev / "route_localnet").write_text(val + "\n")
+    monkeypatch.setattr(netcheck, "SYSCTL_IPV4_CONF", str(tmp_path))
+    problems = netcheck.check_loopback_only([os.getpid()])
+    assert [p for p in problems if "route_localnet" in p] == [
+        "route_localnet is on for eth0: a packet from 127.0.0.1 may leave through it"]

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""ima/dds/xch.py mirrors nodes/include/xch/proto.h: sizes, offsets and constants, from the compiler."""
+"""ima/dds/xch.py mirrors nodes/include/xch/proto.h: sizes, offsets and constants, compiled."""
 
 from __future__ import annotations
 

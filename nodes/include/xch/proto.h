@@ -22,13 +22,16 @@
  *   WELCOME    answer to HELLO (no payload); hdr.node = the agent's node, hdr.frame = number
  *              of nodes in the system. The agent accepts io only once it has discovered every
  *              other node's agent (or they are known dead), so the first exchange is complete.
- *   AGREED     payload struct xch_agreed: the INPUTS of every node for hdr.frame, this node's
- *              own included. Emulated time: the agent waits until every node in the request's
- *              wait mask that is alive on DDS (liveliness) has published that frame; a node
- *              that is dead on DDS is not waited for. So the content depends only on which
- *              nodes published the frame, never on timing. Real time: it waits at most the
- *              agent's --xch-timeout-us (default 2000) after the request, then answers with
- *              what it has.
+ *   AGREED     payload struct xch_agreed: the INPUTS for hdr.frame of this node and of each
+ *              node of the request's wait mask that published them (present says which).
+ *              Emulated time: the agent waits until every node in the request's wait mask
+ *              that is alive on DDS (liveliness) has published that frame; a node that is
+ *              dead on DDS, or whose io link is down, is not waited for. So the content
+ *              depends only on which nodes published the frame, never on timing (the rules,
+ *              and the one exception of a node whose io link just came back, are in
+ *              nodes/dds/agent__agree.h). Real time: it waits at most the agent's
+ *              --xch-timeout-us (default 2000) after the request, then answers with what it
+ *              has.
  *
  * Membership is not decided here: io derives it deterministically from the nodes' heartbeats
  * on CAN (FCS_STATUS_x) and passes it in HEALTH and as the wait mask. */

@@ -22,7 +22,8 @@ import time
 from ima import dds
 from ima.errors import ImaError
 
-INSTANCE_STATES = {1: "alive", 2: "disposed", 4: "no_writers"}
+# dds_sample_info_t.instance_state (DDS_IST_*)
+INSTANCE_STATES = {16: "alive", 32: "disposed", 64: "no_writers"}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -43,9 +44,10 @@ def _to_json(topic: str, sample, t_wall_ns: int) -> dict:
     out = {"topic": topic, "t_recv_wall_ns": t_wall_ns}
     info = getattr(sample, "sample_info", None)
     if info is not None and not info.valid_data:
+        # an instance changed state (a node's io link dropped, an agent went): its key only
         out["valid"] = False
         out["instance_state"] = INSTANCE_STATES.get(int(info.instance_state), "?")
-        out["key"] = dataclasses.asdict(sample.sample) if hasattr(sample, "sample") else None
+        out["node"] = getattr(sample.key_sample, "node", None)
         return out
     out["valid"] = True
     out["sample"] = dataclasses.asdict(sample)
@@ -55,7 +57,7 @@ def _to_json(topic: str, sample, t_wall_ns: int) -> dict:
 def _to_text(topic: str, sample) -> str:
     info = getattr(sample, "sample_info", None)
     if info is not None and not info.valid_data:
-        node = getattr(getattr(sample, "sample", None), "node", "?")
+        node = getattr(sample.key_sample, "node", "?")
         return f"{topic} node{node}: {INSTANCE_STATES.get(int(info.instance_state), '?')}"
     d = dataclasses.asdict(sample)
     head = f"{topic} node{d.pop('node')} frame {d.pop('frame')} t {d.pop('t_ns') / 1e9:.3f} s"
@@ -69,8 +71,15 @@ def listen(domain: int, topics: list[str] | None = None, count: int | None = Non
     if not dds.DOMAIN_MIN - 1 <= domain <= 232:
         raise ImaError(f"DDS domain {domain} out of range 0..232", exit_code=2)
     dds.use_loopback_config()  # before Cyclone creates the domain
-    from cyclonedds.core import Policy, Qos, ReadCondition, SampleState, ViewState, WaitSet
-    from cyclonedds.core import InstanceState
+    from cyclonedds.core import (
+        InstanceState,
+        Policy,
+        Qos,
+        ReadCondition,
+        SampleState,
+        ViewState,
+        WaitSet,
+    )
     from cyclonedds.domain import DomainParticipant
     from cyclonedds.sub import DataReader
     from cyclonedds.topic import Topic

@@ -9,7 +9,8 @@ accepts it only if the kernel would keep its traffic on the loopback interface:
    only what came in on lo and sends only through lo, whatever its address (Cyclone binds its
    receive sockets to INADDR_ANY; ima-dds-node and ima.dds.bind_dds_sockets bind them to lo).
 It also checks that no multicast group is joined on another interface (/proc/PID/net/igmp and
-igmp6) beyond the all-hosts groups the kernel joins by itself. Those tables belong to the
+igmp6) beyond the groups the kernel joins by itself, and that no interface but loopback has
+route_localnet on (which would let a packet with a loopback source out). Those belong to the
 network namespace, not to one process: a group joined by any process shows up.
 """
 
@@ -36,12 +37,19 @@ SOCKID = struct.Struct("=HH16s16sI8s")
 DIAG_MSG_HEAD = struct.Struct("=BBBB")
 DIAG_MSG_TAIL = struct.Struct("=IIIII")
 
-# Groups the kernel joins on every multicast-capable interface by itself.
-KERNEL_GROUPS_V4 = {"010000E0"}  # 224.0.0.1, all hosts (as /proc/net/igmp prints it)
+# Groups the kernel joins by itself (as /proc/net/igmp and igmp6 print them): all hosts on
+# every multicast-capable interface, and on a bridge with multicast snooping the all-snoopers
+# group of RFC 4286 (other runs' network namespaces and bridges come and go on a test host).
+KERNEL_GROUPS_V4 = {"010000E0",  # 224.0.0.1, all hosts
+                    "6A0000E0"}  # 224.0.0.106, all snoopers (bridge)
 KERNEL_GROUPS_V6_PREFIXES = ("ff020000000000000000000000000001",  # all nodes, link-local
                              "ff010000000000000000000000000001",  # all nodes, node-local
                              "ff020000000000000000000000000002",  # all routers
+                             "ff02000000000000000000000000006a",  # all snoopers (bridge)
                              "ff0200000000000000000001ff")  # solicited-node
+
+
+SYSCTL_IPV4_CONF = "/proc/sys/net/ipv4/conf"
 
 
 @dataclass
@@ -166,6 +174,25 @@ def _igmp_problems(pid: int, loopback: str) -> list[str]:
     return problems
 
 
+def _route_localnet_problems(loopback: str) -> list[str]:
+    """Interfaces that would route a packet with a loopback source (net/ipv4/route.c).
+
+    /proc/sys/net shows the network namespace of the process that reads it: ours."""
+    base = SYSCTL_IPV4_CONF
+    problems = []
+    for dev in sorted(os.listdir(base)):
+        if dev in (loopback, "default"):
+            continue
+        try:
+            with open(f"{base}/{dev}/route_localnet") as f:
+                if f.read().strip() != "0":
+                    problems.append(f"route_localnet is on for {dev}: a packet from 127.0.0.1 "
+                                    "may leave through it")
+        except OSError:
+            pass
+    return problems
+
+
 def sockets_of(pid: int) -> list[SockInfo]:
     """Every IP (UDP, TCP) socket pid holds, with its bound device where the kernel says."""
     inodes = _socket_inodes(pid)
@@ -219,4 +246,6 @@ def check_loopback_only(pids, device: str = "lo") -> list[str]:
         if ns not in netns_checked:
             netns_checked.add(ns)
             problems += [f"{who}: {p}" for p in _igmp_problems(pid, device)]
+            if len(netns_checked) == 1:
+                problems += _route_localnet_problems(device)
     return problems

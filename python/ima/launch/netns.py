@@ -34,7 +34,7 @@ _CONFIG = """<?xml version="1.0" encoding="UTF-8"?>
 {peers}
       </Peers>
     </Discovery>
-    <Tracing><Verbosity>warning</Verbosity></Tracing>
+    <Tracing><Verbosity>warning</Verbosity><OutputFile>{log}</OutputFile></Tracing>
   </Domain>
 </CycloneDDS>
 """
@@ -82,7 +82,8 @@ class Namespaces:
     def dds_config(self, node: str, run_dir: Path) -> Path:
         peers = "\n".join(f'        <Peer address="{self.addr[n]}"/>' for n in self.nodes)
         path = run_dir / f"dds-{node}.xml"
-        path.write_text(_CONFIG.format(node=node, peers=peers))
+        log = run_dir / f"dds-{node}-cyclone.log"
+        path.write_text(_CONFIG.format(node=node, peers=peers, log=log))
         return path
 
     def wrap(self, node: str, cmd: list[str]) -> list[str]:

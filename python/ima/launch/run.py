@@ -114,6 +114,7 @@ class _NodeWatch:
                  kills: dict[str, float]) -> None:
         self.procs, self.world, self.run_dir, self.kills = procs, world, run_dir, kills
         self.killed: dict[str, float] = {}
+        self.stopping = threading.Event()  # Ctrl-C: the processes end because they are told to
 
     def _expected(self, name: str, code: int | None) -> str | None:
         """The node whose death this is, if it is one the run asked for."""
@@ -125,6 +126,9 @@ class _NodeWatch:
     def __call__(self) -> None:
         procs = self.procs
         while self.world.poll() is None:
+            bus = procs.procs.get("canbus")
+            if self.stopping.is_set() or (bus is not None and bus.poll() is not None):
+                return  # the run is ending: what exits now follows the bus
             for name, proc in list(procs.procs.items()):
                 code = proc.poll()
                 if name == "world" or code in (None, 0) or name in procs.failed:
@@ -228,6 +232,9 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
                "--trace", str(run_dir / "can.jsonl"), "--stats", str(run_dir / "canbus.json"), "-q"]
     for node, t in kills.items():
         bus_cmd += ["--kill-node", f"{index[node]}@{t:g}"]
+    # Every node's io partition joins in the first quantum, all at once: fixed indices keep
+    # the bus trace the same from run to run.
+    bus_cmd += ["--client-order", ",".join([*names, "world", *(f"{n}/io" for n in names)])]
     if opts.realtime:
         bus_cmd.append("--realtime")
     world_cmd = [sys.executable, "-m", "imaworld", "--bus", str(sock), "--run-dir", str(run_dir),
@@ -291,6 +298,8 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
     def on_signal(signum: int, _frame: object) -> None:
         nonlocal interrupted
         interrupted = True
+        if watch is not None:
+            watch.stopping.set()
         bus = procs.procs.get("canbus")
         if bus is not None and bus.poll() is None:
             bus.send_signal(signal.SIGTERM)

@@ -132,6 +132,15 @@ typedef struct {
 
 static rx_state_t rx;
 
+/* A replica's command as every receiver decodes it: elev, ail, rud, thr. */
+static void cmd_values(const struct rpas_can_act_cmd_a_t *m, double v[4])
+{
+    v[0] = rpas_can_act_cmd_a_elev_cmd_a_decode(m->elev_cmd_a);
+    v[1] = rpas_can_act_cmd_a_ail_cmd_a_decode(m->ail_cmd_a);
+    v[2] = rpas_can_act_cmd_a_rud_cmd_a_decode(m->rud_cmd_a);
+    v[3] = rpas_can_act_cmd_a_thr_cmd_a_decode(m->thr_cmd_a);
+}
+
 static void on_frame(const struct canbus_rec *r)
 {
     const uint8_t *d = r->data;
@@ -268,10 +277,7 @@ static void on_frame(const struct canbus_rec *r)
             struct rpas_can_act_cmd_a_t m;
             if ((rc = rpas_can_act_cmd_a_unpack(&m, d, n)) == 0 && ch < n_nodes) {
                 peer_cmd[ch].have = true;
-                peer_cmd[ch].v[0] = rpas_can_act_cmd_a_elev_cmd_a_decode(m.elev_cmd_a);
-                peer_cmd[ch].v[1] = rpas_can_act_cmd_a_ail_cmd_a_decode(m.ail_cmd_a);
-                peer_cmd[ch].v[2] = rpas_can_act_cmd_a_rud_cmd_a_decode(m.rud_cmd_a);
-                peer_cmd[ch].v[3] = rpas_can_act_cmd_a_thr_cmd_a_decode(m.thr_cmd_a);
+                cmd_values(&m, peer_cmd[ch].v);
             }
             break;
         }
@@ -396,42 +402,45 @@ static void to_inputs(struct xch_inputs *in)
     }
 }
 
+/* Sensor `which` (0 GPS, 1 AHRS, 2 air data) of a node's inputs: false if it holds none. */
+static bool sample_of(const struct xch_inputs *in, unsigned which, int64_t *t, uint32_t *seq,
+                      const double **values)
+{
+    static const uint32_t bit[3] = {XCH_IN_GPS, XCH_IN_AHRS, XCH_IN_AIR};
+    if (!(in->valid & bit[which]))
+        return false;
+    *t = which == 0 ? in->gps_t_ns : which == 1 ? in->ahrs_t_ns : in->air_t_ns;
+    *seq = which == 0 ? in->gps_seq : which == 1 ? in->ahrs_seq : in->air_seq;
+    *values = which == 0 ? in->gps : which == 1 ? in->ahrs : in->air;
+    return true;
+}
+
 /* One sensor's agreed sample: the newest any member holds; its values voted over the members
  * that hold that same sample. Returns the node index (0..2) whose copy carries the sample's
  * other fields, or -1 if no member holds one. */
 static int agree(const struct xch_agreed *ag, unsigned which, voter_t *v, double *out, unsigned dim)
 {
-    static const uint32_t bit[3] = {XCH_IN_GPS, XCH_IN_AHRS, XCH_IN_AIR};
-    int64_t newest = -1;
-    uint32_t seq = 0;
+    int64_t t, newest = -1;
+    uint32_t seq, newest_seq = 0;
+    const double *values;
     int carrier = -1;
-    for (unsigned k = 0; k < n_nodes; k++) {
-        const struct xch_inputs *in = &ag->in[k];
-        if (!(ag->present & NODE_BIT(k)) || !(in->valid & bit[which]))
-            continue;
-        int64_t t = which == 0 ? in->gps_t_ns : which == 1 ? in->ahrs_t_ns : in->air_t_ns;
-        if (t > newest) {
+    for (unsigned k = 0; k < n_nodes; k++)
+        if ((ag->present & NODE_BIT(k)) && sample_of(&ag->in[k], which, &t, &seq, &values) &&
+            t > newest) {
             newest = t;
+            newest_seq = seq;
             carrier = (int)k;
         }
-    }
     if (carrier < 0)
         return -1;
-    const struct xch_inputs *c = &ag->in[carrier];
-    seq = which == 0 ? c->gps_seq : which == 1 ? c->ahrs_seq : c->air_seq;
     double x[VOTER_MAX_CH][VOTER_MAX_DIM] = {{0}};
     uint8_t present = 0;
-    for (unsigned k = 0; k < n_nodes; k++) {
-        const struct xch_inputs *in = &ag->in[k];
-        if (!(ag->present & NODE_BIT(k)) || !(in->valid & bit[which]))
-            continue;
-        int64_t t = which == 0 ? in->gps_t_ns : which == 1 ? in->ahrs_t_ns : in->air_t_ns;
-        uint32_t s = which == 0 ? in->gps_seq : which == 1 ? in->ahrs_seq : in->air_seq;
-        if (t != newest || s != seq)
-            continue;
-        memcpy(x[k], which == 0 ? in->gps : which == 1 ? in->ahrs : in->air, dim * sizeof(double));
-        present |= (uint8_t)NODE_BIT(k);
-    }
+    for (unsigned k = 0; k < n_nodes; k++)
+        if ((ag->present & NODE_BIT(k)) && sample_of(&ag->in[k], which, &t, &seq, &values) &&
+            t == newest && seq == newest_seq) {
+            memcpy(x[k], values, dim * sizeof(double));
+            present |= (uint8_t)NODE_BIT(k);
+        }
     voter_out_t o;
     voter_step(v, (const double(*)[VOTER_MAX_DIM])x, present, &o);
     memcpy(out, o.value, dim * sizeof *out);
@@ -639,10 +648,7 @@ static void tx_process(void)
                 send(RPAS_CAN_ACT_CMD_A_FRAME_ID, buf, rpas_can_act_cmd_a_pack(buf, &m, sizeof buf), t);
                 /* what the others receive: the command as encoded on CAN */
                 own_cmd.have = true;
-                own_cmd.v[0] = rpas_can_act_cmd_a_elev_cmd_a_decode(m.elev_cmd_a);
-                own_cmd.v[1] = rpas_can_act_cmd_a_ail_cmd_a_decode(m.ail_cmd_a);
-                own_cmd.v[2] = rpas_can_act_cmd_a_rud_cmd_a_decode(m.rud_cmd_a);
-                own_cmd.v[3] = rpas_can_act_cmd_a_thr_cmd_a_decode(m.thr_cmd_a);
+                cmd_values(&m, own_cmd.v);
             }
             rpas_fcs_status_msg_t st;
             bool have_st = read_port(p_status, &st, sizeof st);

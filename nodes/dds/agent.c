@@ -251,7 +251,10 @@ static void discover(agent_t *a)
         struct pollfd p[2] = {{.fd = a->wake_rd, .events = POLLIN},
                               {.fd = a->sig_fd, .events = POLLIN}};
         struct timespec ts = ts_of(left);
-        if (ppoll(p, 2, &ts, NULL) > 0) {
+        pthread_mutex_unlock(&a->state);
+        int n = ppoll(p, 2, &ts, NULL);
+        pthread_mutex_lock(&a->state);
+        if (n > 0) {
             if (p[0].revents)
                 drain_wake(a);
             if (p[1].revents)
@@ -300,7 +303,9 @@ static void run(agent_t *a)
             ts = ts_of(a->pend_start_ns + a->o.xch_timeout_ns - agent_mono_ns());
             tsp = &ts;
         }
+        pthread_mutex_unlock(&a->state);
         int n = ppoll(p, 3, tsp, NULL);
+        pthread_mutex_lock(&a->state);
         if (n < 0 && errno != EINTR)
             break;
         if (n <= 0) {
@@ -348,6 +353,10 @@ int main(int argc, char **argv)
     a->start_mono_ns = agent_mono_ns();
     agree_init(&a->agree, a->o.node, a->o.nodes);
     pthread_mutex_init(&a->lock, NULL);
+    pthread_mutex_init(&a->state, NULL);
+    /* Held by this thread from here on, but while it waits (agent__agent.h). */
+    pthread_mutex_lock(&a->state);
+    a->answer_in_listener = true;
     atomic_init(&a->wake_pending, false);
 
     int status = 1;
@@ -358,7 +367,10 @@ int main(int argc, char **argv)
         goto out;
     a->wake_rd = wake[0];
     a->wake_wr = wake[1];
-    a->lat_ns = malloc(AGENT_LAT_MAX * sizeof *a->lat_ns);
+    if (agent_lat_init(&a->xch_lat) != 0 || agent_lat_init(&a->dds_lat) != 0) {
+        fprintf(stderr, "ima-dds-node %s: out of memory\n", a->node_name);
+        goto out;
+    }
     if (a->o.trace_path) {
         a->trace = fopen(a->o.trace_path, "w");
         if (!a->trace) {
@@ -376,6 +388,7 @@ int main(int argc, char **argv)
     discover(a);
     if (!a->stop) {
         /* The launcher waits for this line. A closed stdout is fine (SIGPIPE is ignored). */
+        a->ready = true;
         fputs("ready\n", stdout);
         fflush(stdout);
         run(a);
@@ -383,7 +396,11 @@ int main(int argc, char **argv)
     status = 0;
 out_dds:
     agent_io_shutdown(a);
+    /* Deleting the participant waits for running listeners: they must not wait for us. */
+    a->answer_in_listener = false;
+    pthread_mutex_unlock(&a->state);
     agent_dds_stop(a);
+    pthread_mutex_lock(&a->state);
     if (agent_write_stats(a) != 0)
         status = 1;
 out:
@@ -392,6 +409,7 @@ out:
         agent_trace_simple(a, "dds_exit");
         fclose(a->trace);
     }
-    free(a->lat_ns);
+    agent_lat_free(&a->xch_lat);
+    agent_lat_free(&a->dds_lat);
     return status;
 }

@@ -2,9 +2,14 @@
 /* The DDS agent's state, shared by its parts: DDS side (agent_dds.c), io link (agent_io.c),
  * trace and statistics (agent_out.c) and the main loop (agent.c).
  *
- * Threads: Cyclone calls the listeners on its own threads; they only queue an event or set a
- * flag and wake the main thread through a pipe. Everything else, DDS reads and writes
- * included, happens on the main thread. */
+ * Threads: the main thread serves the io link, the signals and the events the listeners queue.
+ * Cyclone calls the listeners on its own threads. The one on the cross-channel inputs reader
+ * takes the samples and answers a pending request itself, in Cyclone's receive thread, so
+ * that a peer's inputs reach io without waking the main thread first (the exchange's latency
+ * is a frame budget in real time). Every other listener only queues an event or wakes the
+ * main thread through a pipe. The agent's state (the exchange, the peers, the io socket, the
+ * trace, the statistics) is guarded by `state`: the main thread holds it except while it
+ * waits in ppoll, the inputs listener while it runs. */
 #ifndef AGENT__AGENT_H
 #define AGENT__AGENT_H
 
@@ -70,8 +75,13 @@ typedef struct {
     uint64_t written, read, invalid, write_errors;
 } agent_topic_stats_t;
 
-/* Latency samples of the exchange, request to AGREED, in ns. */
+/* A series of latency samples, in ns (the first AGENT_LAT_MAX kept). */
 #define AGENT_LAT_MAX (1u << 20)
+
+typedef struct {
+    uint32_t *ns;
+    uint32_t n;
+} agent_lat_t;
 
 typedef struct agent agent_t;
 
@@ -90,6 +100,10 @@ struct agent {
     agent_writer_t writers[AGENT_MAX_WRITERS];
     int n_writers;
     unsigned bound_sockets;    /* UDP sockets bound to opts.bind_device */
+
+    /* guards everything below but the event queue (see the top of this file) */
+    pthread_mutex_t state;
+    bool answer_in_listener;   /* false from the shutdown on: the listener touches nothing */
 
     /* listener -> main thread */
     pthread_mutex_t lock;
@@ -120,8 +134,9 @@ struct agent {
     /* statistics */
     agent_topic_stats_t ts[T_COUNT];
     uint64_t agreed, waits, timeouts, superseded, bad_datagrams, partial;
-    uint32_t *lat_ns;
-    uint32_t n_lat;
+    agent_lat_t xch_lat;       /* io's request to its AGREED */
+    agent_lat_t dds_lat;       /* a peer's dds_write of its inputs to their take here */
+    bool ready;                /* discovery is over: the DDS latency is measured from here on */
     int64_t start_mono_ns;
 
     FILE *trace;
@@ -130,8 +145,13 @@ struct agent {
 
 int64_t agent_mono_ns(void);
 int64_t agent_wall_ns(void);
+int agent_lat_init(agent_lat_t *l);
+void agent_lat_add(agent_lat_t *l, int64_t ns);
+void agent_lat_free(agent_lat_t *l);
 
 /* agent_dds.c */
+/* Wakes the main thread out of its ppoll (any thread). */
+void agent_wake(agent_t *a);
 int agent_dds_start(agent_t *a);
 void agent_dds_stop(agent_t *a);
 void agent_dds_process_events(agent_t *a);

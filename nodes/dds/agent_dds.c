@@ -24,7 +24,7 @@ static const dds_topic_descriptor_t *const topic_desc[T_COUNT] = {
 
 /* ---- listeners: Cyclone's threads ------------------------------------------------------ */
 
-static void wake(agent_t *a)
+void agent_wake(agent_t *a)
 {
     if (!atomic_exchange(&a->wake_pending, true)) {
         char c = 1;
@@ -44,13 +44,28 @@ static void push_event(agent_t *a, const agent_ev_t *ev)
         a->ev_dropped++;
     }
     pthread_mutex_unlock(&a->lock);
-    wake(a);
+    agent_wake(a);
 }
 
+static void take_topic(agent_t *a, int t);
+
+/* A peer's inputs: taken here, in Cyclone's receive thread, and the pending request answered
+ * at once if they complete it. Other topics are the main thread's. */
 static void on_data_available(dds_entity_t rd, void *arg)
 {
     (void)rd;
-    wake(((agent_rd_ctx_t *)arg)->agent);
+    agent_rd_ctx_t *c = arg;
+    agent_t *a = c->agent;
+    if (c->topic != T_INPUTS) {
+        agent_wake(a);
+        return;
+    }
+    pthread_mutex_lock(&a->state);
+    if (a->answer_in_listener) {
+        take_topic(a, T_INPUTS);
+        agent_io_check_pending(a, false);
+    }
+    pthread_mutex_unlock(&a->state);
 }
 
 /* Cyclone calls this once per match or unmatch (ddsperf relies on the same). */
@@ -514,6 +529,11 @@ static void take_topic(agent_t *a, int t)
             a->ts[t].read++;
             writer_add(a, t, si[i].publication_handle, k);
             if (t == T_INPUTS) {
+                /* Cyclone stamps the sample in dds_write with the writer's clock, this
+                 * machine's as well: the one-way latency of DDS between the two nodes. Not
+                 * before discovery is over: a late joiner receives history. */
+                if (a->ready)
+                    agent_lat_add(&a->dds_lat, dds_time() - si[i].source_timestamp);
                 struct xch_inputs x;
                 inputs_from_dds(&x, &buf[i].in);
                 agree_store(&a->agree, k, buf[i].in.frame, buf[i].in.t_ns, &x);

@@ -83,6 +83,8 @@ void agent_io_close(agent_t *a, const char *reason)
     }
     agent_log(a, "io link closed (%s); waiting for a new connection", reason);
     agent_dds_withdraw(a);
+    /* Closed by the inputs listener, the main thread may be polling the old descriptor. */
+    agent_wake(a);
 }
 
 void agent_io_shutdown(agent_t *a)
@@ -138,8 +140,7 @@ static void send_agreed(agent_t *a, bool timed_out, uint32_t missing)
     if (a->pend_waited)
         a->waits++;
     int64_t lat = agent_mono_ns() - a->pend_start_ns;
-    if (a->lat_ns && a->n_lat < AGENT_LAT_MAX)
-        a->lat_ns[a->n_lat++] = lat > (int64_t)UINT32_MAX ? UINT32_MAX : (uint32_t)lat;
+    agent_lat_add(&a->xch_lat, lat);
     if (timed_out) {
         a->timeouts++;
         if (agent_trace_begin(a, "xch_timeout")) {

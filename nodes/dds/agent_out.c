@@ -76,6 +76,29 @@ void agent_trace_nodes(agent_t *a, const char *key, uint32_t mask)
     fputc(']', a->trace);
 }
 
+int agent_lat_init(agent_lat_t *l)
+{
+    l->n = 0;
+    l->ns = malloc(AGENT_LAT_MAX * sizeof *l->ns);
+    return l->ns ? 0 : -1;
+}
+
+void agent_lat_add(agent_lat_t *l, int64_t ns)
+{
+    if (!l->ns || l->n >= AGENT_LAT_MAX)
+        return;
+    if (ns < 0)
+        ns = 0;
+    l->ns[l->n++] = ns > (int64_t)UINT32_MAX ? UINT32_MAX : (uint32_t)ns;
+}
+
+void agent_lat_free(agent_lat_t *l)
+{
+    free(l->ns);
+    l->ns = NULL;
+    l->n = 0;
+}
+
 static int cmp_u32(const void *x, const void *y)
 {
     uint32_t p = *(const uint32_t *)x, q = *(const uint32_t *)y;
@@ -91,6 +114,23 @@ static double pct_us(const uint32_t *sorted, uint32_t n, double p)
     if (i > n)
         i = n;
     return sorted[i - 1] / 1000.0;
+}
+
+/* "key":{"count":N,"min":..,"median":..,"p95":..,"max":..} in microseconds */
+static void write_lat(FILE *f, const char *key, const agent_lat_t *l)
+{
+    fprintf(f, "\"%s\":", key);
+    uint32_t *sorted = l->n ? malloc(l->n * sizeof *sorted) : NULL;
+    if (!sorted) {
+        fputs("{\"count\":0,\"min\":null,\"median\":null,\"p95\":null,\"max\":null}", f);
+        return;
+    }
+    memcpy(sorted, l->ns, l->n * sizeof *sorted);
+    qsort(sorted, l->n, sizeof *sorted, cmp_u32);
+    fprintf(f, "{\"count\":%u,\"min\":%.1f,\"median\":%.1f,\"p95\":%.1f,\"max\":%.1f}", l->n,
+            sorted[0] / 1000.0, pct_us(sorted, l->n, 50), pct_us(sorted, l->n, 95),
+            sorted[l->n - 1] / 1000.0);
+    free(sorted);
 }
 
 int agent_write_stats(agent_t *a)
@@ -122,18 +162,9 @@ int agent_write_stats(agent_t *a)
             a->agreed, a->partial, a->waits, a->timeouts, a->superseded, a->agree.stale,
             a->bad_datagrams, a->io_connections, a->io_disconnects, a->ev_dropped,
             a->bound_sockets);
-    fprintf(f, "\"exchange_latency_us\":");
-    uint32_t *sorted = a->n_lat ? malloc(a->n_lat * sizeof *sorted) : NULL;
-    if (sorted) {
-        memcpy(sorted, a->lat_ns, a->n_lat * sizeof *sorted);
-        qsort(sorted, a->n_lat, sizeof *sorted, cmp_u32);
-        fprintf(f, "{\"count\":%u,\"median\":%.1f,\"p95\":%.1f,\"max\":%.1f}", a->n_lat,
-                pct_us(sorted, a->n_lat, 50), pct_us(sorted, a->n_lat, 95),
-                sorted[a->n_lat - 1] / 1000.0);
-        free(sorted);
-    } else {
-        fprintf(f, "{\"count\":0,\"median\":null,\"p95\":null,\"max\":null}");
-    }
+    write_lat(f, "exchange_latency_us", &a->xch_lat);
+    fputc(',', f);
+    write_lat(f, "dds_latency_us", &a->dds_lat);
     fputs(",\"peers\":[", f);
     bool first = true;
     for (unsigned k = 1; k <= a->o.nodes; k++) {

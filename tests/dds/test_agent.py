@@ -34,6 +34,10 @@ def test_agreed_holds_every_nodes_inputs(agents, connect):
         assert st["topics"]["rpas_CrossChannelInputs"]["written"] == 20
         assert st["topics"]["rpas_CrossChannelInputs"]["read"] >= 40
         assert st["exchange_latency_us"]["count"] == 20
+        # every peer sample taken after discovery: 2 peers x 20 frames, one-way DDS latency
+        lat = st["dds_latency_us"]
+        assert lat["count"] == 40
+        assert 0 < lat["min"] <= lat["median"] <= lat["p95"] <= lat["max"] < 1e6
         ready = a.of_kind("dds_ready")
         assert ready and len(ready[0]["discovered"]) == 2 and ready[0]["missing"] == []
 
@@ -319,3 +323,8 @@ def test_c_client_through_two_agents(agents, run_dir):
     assert p.returncode == 0, p.stderr
     r = json.loads(p.stdout)
     assert r["samples"] == 30 and r["incomplete"] == 0 and r["median_us"] > 0
+    assert r["min_us"] <= r["median_us"] <= r["p95_us"] <= r["max_us"]
+    for a in ags:
+        a.stop()
+    # node1 took node2's inputs of the 35 rounds (warm-up included) as they came
+    assert ags[0].read_stats()["dds_latency_us"]["count"] == 35

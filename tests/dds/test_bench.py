@@ -27,3 +27,25 @@ def test_parse_ddsperf_skips_the_first_second():
 def test_parse_ddsperf_without_pongs():
     with pytest.raises(ImaError):
         bench.parse_ddsperf("[1] participant vm:1: new (self)\n")
+
+
+def test_measure_both_sides_alternately():
+    """A short real run: two agents and ima-xch-bench, then ddsperf, twice."""
+    told = []
+    r = bench.measure(samples=20, repeats=2, progress=told.append, ddsperf_seconds=2)
+    assert [t[:5] for t in told] == ["[1/2]", "[1/2]", "[2/2]", "[2/2]"]
+    assert len(r["repeats"]) == 2
+    # node1's agent takes node2's inputs of every round, warm-up included
+    assert r["dds_latency_samples"] == 2 * (20 + 50)
+    assert r["xch_latency_samples"] == 2 * 20 and r["xch_latency_incomplete"] == 0
+    assert 0 < r["dds_latency_us_min"] <= r["dds_latency_us_median"] <= r["dds_latency_us_p95"]
+    assert 0 < r["xch_latency_us_min"] <= r["xch_latency_us_median"] <= r["xch_latency_us_p95"]
+    assert r["ddsperf_samples"] > 0 and r["ddsperf_latency_us_median"] > 0
+    assert r["ratio"] == round(r["dds_latency_us_median"] / r["ddsperf_latency_us_median"], 2)
+    assert r["xch_ratio"] == round(r["xch_latency_us_median"] / r["ddsperf_latency_us_median"],
+                                   2)
+
+
+def test_measure_refuses_nothing_to_measure():
+    with pytest.raises(ImaError):
+        bench.measure(samples=0)

@@ -1,19 +1,25 @@
 # SPDX-License-Identifier: Apache-2.0
 """Benchmark of the cross-channel link: the product's DDS latency against Cyclone's own ddsperf.
 
-Both figures come from the same run, the same configuration file (loopback only), the same
-domain id, one after the other so that they do not compete for the CPU:
+All figures come from the same run, the same configuration file (loopback only), the same
+domain id, one after the other so that they do not compete for the CPU. ima-xch-bench plays
+the io partitions of two nodes (one thread each) whose real agents (ima-dds-node, real-time
+mode) exchange their inputs over DDS, 1000 rounds; in each, node B's io sends its INPUTS at
+t0 and node A's io receives the AGREED holding them at t1.
 
-- dds_latency_us: ONE-WAY latency of the product's path, measured by ima-xch-bench playing
-  the io partitions of two nodes whose real agents (ima-dds-node, real-time mode) talk over
-  DDS: node B's io sends its INPUTS at t0, node A's io receives the AGREED holding them at t1.
-  Both instants are read in the same process on CLOCK_MONOTONIC, so no two clocks are
-  compared. The path: io B -> Unix socket -> agent B -> dds_write -> UDP on lo -> agent A's
-  Cyclone receive thread -> agent A's main thread -> Unix socket -> io A.
+- dds_latency_us (node to node): ONE-WAY latency of DDS between the two nodes' agents, with
+  the product's types, QoS and threads: from agent B's dds_write of its inputs to agent A's
+  take of them (in Cyclone's receive thread, the listener). Cyclone stamps each sample with
+  the writer's clock; agent A subtracts it from its own clock on taking it. Both are this
+  machine's clock. Each agent keeps these figures in its statistics (dds_latency_us).
+- xch_latency_us (io to io): t1 - t0, both read on CLOCK_MONOTONIC. It adds the two hops
+  inside the nodes: io B -> Unix socket -> agent B's main thread, and agent A -> Unix socket
+  -> io A, each a process wake-up.
 - ddsperf_latency_us: Cyclone's ddsperf ping/pong pair at a similar rate (500 Hz) on the same
   domain; ddsperf reports half the round trip, so it too is a one-way figure, of bare DDS.
 
-ratio = dds / ddsperf: the price of the agent process and its two Unix-socket hops.
+ratio = dds / ddsperf: what the product's use of DDS costs over DDS's own tool.
+xch_ratio = xch / ddsperf: that, plus the partition-to-agent hops within the nodes.
 """
 
 from __future__ import annotations
@@ -34,8 +40,9 @@ from ima.dds.agent import start_agents
 from ima.errors import ImaError
 
 DEFAULT_SAMPLES = 1000
+DEFAULT_REPEATS = 3  # each side measured three times, alternately
 GAP_US = 1000  # pause between the two nodes' INPUTS, and after each round
-DDSPERF_SECONDS = 5
+DDSPERF_SECONDS = 4  # the first second is warm-up, left out
 DDSPERF_RATE = "500Hz"  # about our rate: one exchange per 2 ms
 
 # ddsperf's per-second line: "... size 12 mean 25.7us min 8.8us 50% 15.3us 90% 36.3us ... cnt 494"
@@ -50,7 +57,8 @@ def _xch_bench() -> Path:
     return path
 
 
-def _product_latency(domain: int, samples: int, run_dir: Path) -> dict:
+def _product_latency(domain: int, samples: int, run_dir: Path) -> tuple[dict, dict]:
+    """(io-to-io figures of ima-xch-bench, node A's agent's DDS latency statistics)."""
     agents = start_agents(2, run_dir, domain, realtime=True,
                           extra=["--xch-timeout-us", "100000"])
     try:
@@ -63,7 +71,15 @@ def _product_latency(domain: int, samples: int, run_dir: Path) -> dict:
             a.stop()
     if p.returncode != 0:
         raise ImaError(f"ima-xch-bench failed: {p.stderr.strip()}")
-    return json.loads(p.stdout)
+    stats = agents[0].read_stats()
+    node_to_node = (stats or {}).get("dds_latency_us") or {}
+    if not node_to_node.get("count"):
+        raise ImaError(f"node{agents[0].node}'s agent measured no DDS latency "
+                       f"(statistics: {agents[0].stats})")
+    io = json.loads(p.stdout)
+    io_to_io = {"count": io["samples"], "min": io["min_us"], "median": io["median_us"],
+                "p95": io["p95_us"], "incomplete": io["incomplete"]}
+    return io_to_io, node_to_node
 
 
 def parse_ddsperf(text: str) -> dict:
@@ -78,17 +94,17 @@ def parse_ddsperf(text: str) -> dict:
             "count": int(sum(r[6] for r in rows))}
 
 
-def _ddsperf_latency(domain: int) -> dict:
+def _ddsperf_latency(domain: int, seconds: int = DDSPERF_SECONDS) -> dict:
     exe = shutil.which("ddsperf")
     if not exe:
         raise ImaError("ddsperf not found (Debian package cyclonedds-tools)")
     env = dds.dds_env()
-    pong = subprocess.Popen([exe, "-D", str(DDSPERF_SECONDS + 2), "-i", str(domain), "pong"],
+    pong = subprocess.Popen([exe, "-D", str(seconds + 2), "-i", str(domain), "pong"],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
     try:
-        ping = subprocess.run([exe, "-D", str(DDSPERF_SECONDS), "-i", str(domain), "ping",
+        ping = subprocess.run([exe, "-D", str(seconds), "-i", str(domain), "ping",
                                DDSPERF_RATE], capture_output=True, text=True, env=env,
-                              timeout=DDSPERF_SECONDS + 30)
+                              timeout=seconds + 30)
     finally:
         pong.terminate()
         try:
@@ -99,52 +115,81 @@ def _ddsperf_latency(domain: int) -> dict:
     return parse_ddsperf(ping.stdout)
 
 
-def measure(samples: int = DEFAULT_SAMPLES, progress=None) -> dict:
-    """Runs both measurements; `progress(text)` is told what runs next."""
+def measure(samples: int = DEFAULT_SAMPLES, repeats: int = DEFAULT_REPEATS,
+            progress=None, ddsperf_seconds: int = DDSPERF_SECONDS) -> dict:
+    """Runs both measurements `repeats` times, alternately; `progress(text)` is told what runs
+    next. Each figure is the median of its per-repeat figures (min: the least; samples: the
+    sum), so that a slow moment of the machine weighs on both sides alike."""
     say = progress or (lambda text: None)
+    if samples < 1 or repeats < 1 or ddsperf_seconds < 2:
+        raise ImaError("the DDS benchmark needs at least one sample, one repeat and two "
+                       "seconds of ddsperf")
     domain = dds.domain_for_run()
+    runs = []
     try:
         with tempfile.TemporaryDirectory(prefix="ima-bench-dds-") as tmp:
-            say(f"cross-channel exchange through two agents: {samples} rounds")
-            ours = _product_latency(domain, samples, Path(tmp))
-            say(f"ddsperf ping/pong at {DDSPERF_RATE}: {DDSPERF_SECONDS} s")
-            ref = _ddsperf_latency(domain)
+            for i in range(repeats):
+                tag = f"{i + 1}/{repeats}"
+                say(f"[{tag}] cross-channel exchange through two agents: {samples} rounds")
+                run_dir = Path(tmp) / f"repeat{i + 1}"
+                run_dir.mkdir()
+                xch, ours = _product_latency(domain, samples, run_dir)
+                say(f"[{tag}] ddsperf ping/pong at {DDSPERF_RATE}: {ddsperf_seconds} s")
+                ref = _ddsperf_latency(domain, ddsperf_seconds)
+                runs.append({"dds": ours, "xch": xch, "ddsperf": ref})
     finally:
         dds.release_domain(domain)
-    result = {
-        "dds_latency_us_median": ours["median_us"],
-        "dds_latency_us_p95": ours["p95_us"],
-        "dds_latency_us_min": ours["min_us"],
-        "dds_latency_samples": ours["samples"],
-        "dds_latency_incomplete": ours["incomplete"],
-        "dds_latency_measure": "one-way, io B INPUTS -> io A AGREED through both agents, "
-                               "one process's CLOCK_MONOTONIC",
-        "ddsperf_latency_us_median": ref["median"],
-        "ddsperf_latency_us_p90": ref["p90"],
-        "ddsperf_samples": ref["count"],
+
+    def med(side, key):
+        return round(statistics.median(r[side][key] for r in runs), 1)
+
+    def pooled(side):
+        return {f"{side}_latency_us_median": med(side, "median"),
+                f"{side}_latency_us_p95": med(side, "p95"),
+                f"{side}_latency_us_min": min(r[side]["min"] for r in runs),
+                f"{side}_latency_samples": sum(r[side]["count"] for r in runs)}
+
+    def ratio(side):
+        ref = med("ddsperf", "median")
+        return round(med(side, "median") / ref, 2) if ref else None
+
+    return {
+        **pooled("dds"),
+        "dds_latency_measure": "one-way node to node: agent B's dds_write of its inputs -> "
+                               "agent A's take (source timestamp against A's clock)",
+        **pooled("xch"),
+        "xch_latency_incomplete": sum(r["xch"]["incomplete"] for r in runs),
+        "xch_latency_measure": "one-way io to io: io B's INPUTS -> io A's AGREED through both "
+                               "agents, CLOCK_MONOTONIC",
+        "ddsperf_latency_us_median": med("ddsperf", "median"),
+        "ddsperf_latency_us_p90": med("ddsperf", "p90"),
+        "ddsperf_samples": sum(r["ddsperf"]["count"] for r in runs),
         "ddsperf_measure": f"round trip / 2, ddsperf ping {DDSPERF_RATE} / pong",
-        "ratio": round(ours["median_us"] / ref["median"], 2) if ref["median"] else None,
+        "ratio": ratio("dds"),
+        "xch_ratio": ratio("xch"),
+        "repeats": [{f"{side}_us": r[side]["median"] for side in ("dds", "xch", "ddsperf")}
+                    for r in runs],
         "domain": domain,
         "config": str(dds.config_path()),
         "cpus": os.cpu_count(),
     }
-    return result
 
 
-def run(json_out: bool = False, samples: int = DEFAULT_SAMPLES) -> int:
+def run(json_out: bool = False, samples: int = DEFAULT_SAMPLES,
+        repeats: int = DEFAULT_REPEATS) -> int:
     """Runs the benchmark, prints JSON if `json_out` (else a table); exit code."""
     from rich.console import Console
 
     err = Console(stderr=True)
     if json_out:
         with err.status("benchmarking the DDS link") as status:
-            result = measure(samples, progress=lambda text: status.update(text))
+            result = measure(samples, repeats, progress=lambda text: status.update(text))
         json.dump(result, sys.stdout, indent=2)
         sys.stdout.write("\n")
         return 0
     out = Console()
     with out.status("benchmarking the DDS link") as status:
-        result = measure(samples, progress=lambda text: status.update(text))
+        result = measure(samples, repeats, progress=lambda text: status.update(text))
     out.print("[bold]DDS cross-channel benchmark[/bold]")
     for key, value in result.items():
         out.print(f"  {key:28} {value}")
@@ -157,9 +202,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", action="store_true", help="print the results as JSON")
     parser.add_argument("--samples", type=int, default=DEFAULT_SAMPLES, metavar="N",
                         help=f"exchange rounds measured (default {DEFAULT_SAMPLES})")
+    parser.add_argument("--repeats", type=int, default=DEFAULT_REPEATS, metavar="N",
+                        help=f"times each side is measured, alternately (default "
+                             f"{DEFAULT_REPEATS})")
     args = parser.parse_args(argv)
     try:
-        return run(json_out=args.json, samples=args.samples)
+        return run(json_out=args.json, samples=args.samples, repeats=args.repeats)
     except ImaError as e:
         print(f"ima.bench.dds: {e}", file=sys.stderr)
         return e.exit_code

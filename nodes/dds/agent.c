@@ -292,6 +292,8 @@ static void discover(agent_t *a)
         }
 }
 
+#define HUNG_CHECK_NS (100 * 1000000LL)
+
 static void run(agent_t *a)
 {
     while (!a->stop) {
@@ -301,6 +303,9 @@ static void run(agent_t *a)
         struct timespec ts, *tsp = NULL;
         if (a->pending && a->o.realtime) {
             ts = ts_of(a->pend_start_ns + a->o.xch_timeout_ns - agent_mono_ns());
+            tsp = &ts;
+        } else if (a->pending && a->pend_waited) {
+            ts = ts_of(HUNG_CHECK_NS); /* is the peer we wait for hung? */
             tsp = &ts;
         }
         pthread_mutex_unlock(&a->state);

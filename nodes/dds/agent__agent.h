@@ -67,6 +67,7 @@ typedef struct {
     bool alive;          /* its inputs writer is alive on DDS */
     bool dead;           /* latched */
     bool deadline_missed;/* a NodeHealth deadline miss traced, no sample since */
+    int64_t last_rx_ns;  /* CLOCK_MONOTONIC of its latest sample taken, any topic */
     int64_t lost_wall_ns;
     uint64_t deadline_misses;
 } agent_peer_t;
@@ -160,6 +161,9 @@ bool agent_dds_discovery_complete(agent_t *a, uint32_t *missing);
 int agent_dds_publish(agent_t *a, int topic, const struct xch_hdr *h, const void *payload);
 void agent_dds_withdraw(agent_t *a);
 unsigned agent_dds_bind_sockets(agent_t *a);
+/* Emulated time: latches as hung the peers of `missing` that are silent (see agent_dds.c);
+ * true if it did any. */
+bool agent_dds_declare_hung(agent_t *a, uint32_t missing);
 
 /* agent_io.c */
 int agent_io_listen(agent_t *a);

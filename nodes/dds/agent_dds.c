@@ -316,6 +316,27 @@ static void peer_lost(agent_t *a, unsigned k, const char *reason)
     agent_log(a, "node%u lost on DDS (%s): no longer waited for", k, reason);
 }
 
+/* A hung processor: its agent lives on (its DDS liveliness holds) but its partitions are
+ * frozen, so it publishes nothing. A peer this agent has waited for a whole lease period,
+ * which has published nothing in that time and whose NodeHealth deadline was missed, is
+ * latched dead like a lost one: the live nodes go on without it. */
+bool agent_dds_declare_hung(agent_t *a, uint32_t missing)
+{
+    int64_t now = agent_mono_ns();
+    bool any = false;
+    for (unsigned k = 1; k <= a->o.nodes; k++) {
+        agent_peer_t *p = &a->peer[k - 1];
+        if (!(missing & (1u << (k - 1))) || p->dead || !p->deadline_missed)
+            continue;
+        int64_t since = p->last_rx_ns > a->pend_start_ns ? p->last_rx_ns : a->pend_start_ns;
+        if (now - since < a->o.lease_ns)
+            continue;
+        peer_lost(a, k, "hung");
+        any = true;
+    }
+    return any;
+}
+
 static void peer_alive(agent_t *a, unsigned k)
 {
     if (k < 1 || k > a->o.nodes || k == a->o.node)
@@ -527,6 +548,7 @@ static void take_topic(agent_t *a, int t)
                 continue;
             }
             a->ts[t].read++;
+            a->peer[k - 1].last_rx_ns = agent_mono_ns();
             writer_add(a, t, si[i].publication_handle, k);
             if (t == T_INPUTS) {
                 /* Cyclone stamps the sample in dds_write with the writer's clock, this

@@ -157,6 +157,8 @@ void agent_io_check_pending(agent_t *a, bool timed_out)
     if (!a->pending)
         return;
     uint32_t missing = agree_missing(&a->agree, a->pend_frame, a->pend_mask);
+    if (missing && !a->o.realtime && agent_dds_declare_hung(a, missing))
+        missing = agree_missing(&a->agree, a->pend_frame, a->pend_mask);
     if (missing && a->o.realtime && agent_mono_ns() - a->pend_start_ns >= a->o.xch_timeout_ns)
         timed_out = true;
     if (missing && !timed_out) {

@@ -26,6 +26,7 @@ static void usage(FILE *f)
           "  --max-clients N          connected clients at most (64)\n"
           "  --fault KIND:KEY=VAL,... arm a fault (see nodes/README.md); repeatable\n"
 "  --kill-node N@SECONDS    kill every client of node N (hello.node) at that time; repeatable\n"
+          "  --hang-node N@SECONDS    freeze them instead (SIGSTOP): a hung processor; repeatable\n"
           "  --client-order A,B,...   client indices by name (deterministic for racy joins)\n"
           "  --bus-off-recovery       clients recover from bus-off after 128 x 11 bit times\n"
           "  --max-rejects N          disconnect a client after N+1 rejected records (100)\n"
@@ -68,7 +69,8 @@ int main(int argc, char **argv)
 {
     enum {
         O_SOCKET = 256, O_BITRATE, O_QUANTUM, O_LOCKSTEP, O_DURATION, O_END, O_REALTIME,
-        O_TRACE, O_STATS, O_MAXCL, O_FAULT, O_RECOVER, O_MAXREJ, O_SENDTO, O_CLBUF, O_GAP, O_KILL, O_ORDER,
+        O_TRACE, O_STATS, O_MAXCL, O_FAULT, O_RECOVER, O_MAXREJ, O_SENDTO, O_CLBUF, O_GAP, O_KILL,
+        O_HANG, O_ORDER,
         O_HELP
     };
     static const struct option longopts[] = {
@@ -84,6 +86,7 @@ int main(int argc, char **argv)
         {"max-clients", required_argument, NULL, O_MAXCL},
         {"fault", required_argument, NULL, O_FAULT},
         {"kill-node", required_argument, NULL, O_KILL},
+        {"hang-node", required_argument, NULL, O_HANG},
         {"client-order", required_argument, NULL, O_ORDER},
         {"bus-off-recovery", no_argument, NULL, O_RECOVER},
         {"max-rejects", required_argument, NULL, O_MAXREJ},
@@ -162,12 +165,14 @@ int main(int argc, char **argv)
                 o.n_faults++;
             break;
         }
-        case O_KILL: {
+        case O_KILL:
+        case O_HANG: {
             char *at = strchr(optarg, '@'), *end;
             double when = at ? strtod(at + 1, &end) : -1;
             if (!at || at == optarg || parse_i64_n(optarg, (size_t)(at - optarg), 1, 255, &v) ||
                 end == at + 1 || *end || !(when >= 0) || when > 9e9) {
-                bad = "--kill-node must be NODE@SECONDS, e.g. 2@120";
+                bad = opt == O_KILL ? "--kill-node must be NODE@SECONDS, e.g. 2@120"
+                                  : "--hang-node must be NODE@SECONDS, e.g. 2@120";
                 break;
             }
             canbus_kill_t *k = realloc(o.kills, (o.n_kills + 1) * sizeof *k);
@@ -177,7 +182,8 @@ int main(int argc, char **argv)
             }
             o.kills = k;
             o.kills[o.n_kills++] = (canbus_kill_t){.node = (uint32_t)v,
-                                                   .t_ns = (int64_t)llround(when * 1e9)};
+                                                   .t_ns = (int64_t)llround(when * 1e9),
+                                                   .sig = opt == O_KILL ? SIGKILL : SIGSTOP};
             break;
         }
         case O_ORDER: {

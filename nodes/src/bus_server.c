@@ -779,8 +779,9 @@ static void wait_queues(canbus_bus_t *b)
     }
 }
 
-/* --kill-node: kills the processes of every client of the node and drops them, at the start
- * of the quantum b->t (all of them are waiting for it: nothing they do is half done). */
+/* --kill-node, --hang-node: kills (or freezes) the processes of every client of the node and
+ * drops them, at the start of the quantum b->t (all of them are waiting for it: nothing they
+ * do is half done). */
 static void apply_kills(canbus_bus_t *b)
 {
     for (size_t k = 0; k < b->o.n_kills; k++) {
@@ -788,9 +789,10 @@ static void apply_kills(canbus_bus_t *b)
         if (kill_req->done || kill_req->t_ns > b->t)
             continue;
         kill_req->done = true;
+        bool hang = kill_req->sig == SIGSTOP;
         canbus_sbuf_t *s = &b->line;
-        line_head(s, b->t, "node_kill");
-        canbus_sb_str(s, ",\"killed_node\":");
+        line_head(s, b->t, hang ? "node_hang" : "node_kill");
+        canbus_sb_str(s, hang ? ",\"hung_node\":" : ",\"killed_node\":");
         canbus_sb_u64(s, kill_req->node);
         canbus_sb_str(s, ",\"clients\":[");
         bool first = true;
@@ -799,16 +801,16 @@ static void apply_kills(canbus_bus_t *b)
             if (c->gone || c->index < 0 || c->node != kill_req->node)
                 continue;
             if (c->pid > 0)
-                kill(c->pid, SIGKILL);
+                kill(c->pid, kill_req->sig);
             if (!first)
                 canbus_sb_str(s, ",");
             first = false;
             canbus_sb_json_str(s, c->name, sizeof c->name);
-            client_leave(b, c, "node_killed");
+            client_leave(b, c, hang ? "node_hung" : "node_killed");
         }
         canbus_sb_str(s, "]}\n");
         trace_write(b, s);
-        info(b, "node %u killed at t=%" PRId64 " ns", kill_req->node, b->t);
+        info(b, "node %u %s at t=%" PRId64 " ns", kill_req->node, hang ? "hung" : "killed", b->t);
     }
 }
 

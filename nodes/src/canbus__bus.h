@@ -36,12 +36,14 @@ typedef struct canbus_cli_fault {
     char target_name[CANBUS_NAME_LEN + 1];
 } canbus_cli_fault_t;
 
-/* --kill-node: at the first quantum starting at or after t_ns, every client of `node` is
- * killed (SIGKILL to the peer process) and dropped: the processor stops at a deterministic
- * instant, with every window before it finished (its SKE had sent DONE). */
+/* --kill-node / --hang-node: at the first quantum starting at or after t_ns, every client
+ * of `node` gets `sig` (SIGKILL: the processor dies; SIGSTOP: it hangs, its processes alive
+ * but frozen) and is dropped: the processor stops at a deterministic instant, with every
+ * window before it finished (its SKE had sent DONE). */
 typedef struct canbus_kill {
     uint32_t node;
     int64_t t_ns;
+    int sig;
     bool done;
 } canbus_kill_t;
 

@@ -247,13 +247,18 @@ def test_io_reconnects_after_a_restart(agents, connect):
     assert ags[1].of_kind("xch_peer_withdrawn", peer="node1")
 
 
+def timed_exchange(client, frame: int, timeout: float) -> tuple:
+    """(AGREED, seconds waited) of node 1's frame, awaiting nodes 1 and 2."""
+    t0 = time.monotonic()
+    got = client.exchange(frame, frame * 50_000_000, inputs_for(1, frame, 0b11), timeout=timeout)
+    return got, time.monotonic() - t0
+
+
 def test_realtime_waits_at_most_the_timeout(agents, connect):
     ags = agents(2, realtime=True, extra=["--xch-timeout-us", "20000"])
     c1, c2 = connect(ags[0]), connect(ags[1])
     exchange_round({1: c1, 2: c2}, 0, {1: 0b11, 2: 0b11})
-    t0 = time.monotonic()
-    got = c1.exchange(1, 50_000_000, inputs_for(1, 1, 0b11), timeout=5)
-    waited = time.monotonic() - t0
+    got, waited = timed_exchange(c1, 1, timeout=5)
     assert got.present == 0b01
     assert 0.019 <= waited < 1.0
     ags[0].stop()
@@ -274,6 +279,41 @@ def test_health_deadline_miss_is_traced(agents, connect):
     misses = ags[1].of_kind("dds_deadline_missed", peer="node1")
     assert len(misses) == 2, misses  # one per episode, not one per period
     assert ags[1].read_stats()["peers"][0]["deadline_misses"] >= 4
+
+
+def test_hung_peer_is_not_waited_for_after_a_lease(agents, connect):
+    """Emulated time: node 2's agent lives on but its io froze (a hung processor)."""
+    ags = agents(2, extra=["--lease-ms", "400", "--deadline-ms", "100"])
+    c1, c2 = connect(ags[0]), connect(ags[1])
+    for c in (c1, c2):
+        c.send(xch.HEALTH, 0, 0, xch.pack_health(membership=0b11))
+    exchange_round({1: c1, 2: c2}, 0, {1: 0b11, 2: 0b11})
+    # node 2 goes silent, its io link still open: node 1 waits, then gives up on it
+    got, waited = timed_exchange(c1, 1, timeout=10)
+    assert got.present == 0b01
+    assert 0.4 <= waited < 5.0
+    # and never waits for it again
+    assert c1.exchange(2, 100_000_000, inputs_for(1, 2, 0b11), timeout=1).present == 0b01
+    ags[0].stop()
+    (lost,) = ags[0].of_kind("dds_peer_lost")
+    assert lost["peer"] == "node2" and lost["reason"] == "hung" and lost["was_alive"]
+    assert ags[0].of_kind("dds_deadline_missed", peer="node2")
+
+
+def test_slow_peer_that_publishes_its_health_is_waited_for(agents, connect):
+    ags = agents(2, extra=["--lease-ms", "300", "--deadline-ms", "100"])
+    c1, c2 = connect(ags[0]), connect(ags[1])
+    exchange_round({1: c1, 2: c2}, 0, {1: 0b11, 2: 0b11})
+    c1.send_inputs(1, 50_000_000, inputs_for(1, 1, 0b11))
+    for i in range(12):  # 1.2 s: four lease periods, its health on time
+        c2.send(xch.HEALTH, i, 0, xch.pack_health(membership=0b11))
+        time.sleep(0.1)
+    with pytest.raises(TimeoutError):
+        c1.await_agreed(1, timeout=0.05)
+    c2.send_inputs(1, 50_000_000, inputs_for(2, 1, 0b11))
+    assert c1.await_agreed(1).present == 0b11
+    ags[0].stop()
+    assert not ags[0].of_kind("dds_peer_lost")
 
 
 def test_missing_agent_at_startup_is_not_waited_for(agent_bin, run_dir, domain):

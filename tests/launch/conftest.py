@@ -49,7 +49,7 @@ class LaunchCache:
             result = launch_run.launch(opts, on_status=on_status)
             pilot = Path(opts.pilot) if opts.pilot else flight.default_pilot()
             summary = launch_summary.summarise(run_dir, pilot, opts.duration_s, result.nodes,
-                                               result.killed, result.wall_s)
+                                               result.killed, result.wall_s, hung=result.hung)
             self.runs[name] = Run(run_dir, summary, result)
         return self.runs[name]
 

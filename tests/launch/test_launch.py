@@ -124,6 +124,9 @@ def test_ctrl_c_stops_everything(tmp_path):
     (["--kill-node", "node9@10"], "no node 'node9'"),
     (["--kill-node", "node2"], "NODE@SECONDS"),
     (["--kill-node", "node2@900"], "after the end"),
+    (["--hang-node", "node2@x"], "--hang-node wants NODE@SECONDS"),
+    (["--hang-node", "node7@10"], "no node 'node7'"),
+    (["--hang-node", "node2@10", "--kill-node", "node2@20"], "either killed or hung"),
     (["--test-wrong-output", "node2@5:yaw=1"], "AXIS"),
 ])
 def test_bad_options_are_clear_errors(args, message, tmp_path):

@@ -36,6 +36,11 @@ def kill_one(launches):
 
 
 @pytest.fixture(scope="module")
+def hang_one(launches):
+    return launches.launch("hang_one", duration_s=200.0, seed=SEED, hang=[("node2", 120.0)])
+
+
+@pytest.fixture(scope="module")
 def wrong_output(launches):
     return launches.launch("wrong", duration_s=300.0, seed=SEED,
                            wrong_output=[("node3", "elev", 0.3, 100.0)])
@@ -102,6 +107,40 @@ def test_killed_node_is_voted_out_within_three_frames(kill_one):
     # the surviving replicas' monitors saw node2 go
     assert any(r["node"] == "node1" and "node2 voted out" in r["text"] for r in s["monitor_reports"])
     assert s["killed"] == [{"node": "node2", "t_s": 120.0}]
+
+
+def test_hung_node_is_found_by_the_dds_deadline_and_flown_around_as_a_dead_one(hang_one,
+                                                                              kill_one):
+    s = hang_one.summary
+    _flew(hang_one, 200)
+    assert not within(s, LIGHT_BOUNDS), (within(s, LIGHT_BOUNDS), dump(hang_one))
+    assert s["hung"] == [{"node": "node2", "t_s": 120.0}] and s["killed"] == []
+    # the bus froze node2's SKE and io at 120 s: nothing of it on the bus afterwards
+    (hang,) = hang_one.records("can.jsonl", "node_hang")
+    assert hang["hung_node"] == 2 and hang["t_ns"] == 120_000_000_000
+    assert sorted(hang["clients"]) == ["node2", "node2/io"]
+    assert not [r for r in hang_one.records("can.jsonl", "can_tx")
+                if r.get("from", "").startswith("node2/") and r["start_ns"] >= 120_000_000_000]
+    out = s["voted_out"]
+    assert [(v["node"], v["reason"]) for v in out] == [("node2", "absent")], dump(hang_one)
+    assert 120.0 <= out[0]["t_s"] <= 120.0 + 3 * MAF_S, out
+    assert s["membership"] == ["node1", "node3"] and s["membership_agreed"], dump(hang_one)
+    # DDS: node2's agent lives on, its liveliness holds, but its health stops: the others
+    # miss its NodeHealth deadline and, waiting for its inputs, latch it as hung
+    for k in (1, 3):
+        dds = hang_one.records(f"dds{k}.jsonl")
+        assert any(r["kind"] == "dds_deadline_missed" and r["peer"] == "node2" for r in dds)
+        lost = [r for r in dds if r["kind"] == "dds_peer_lost" and r["peer"] == "node2"]
+        assert [(r["reason"], r["was_alive"]) for r in lost] == [("hung", True)], lost
+    # the frozen processor is switched off at the end; nothing else failed
+    codes = hang_one.result.returncodes
+    assert codes["node2"] == -9 and codes["node2/dds"] == 0
+    assert all(c == 0 for name, c in codes.items() if name != "node2"), codes
+    # a node that hangs is flown around exactly as one that dies at the same instant
+    a = [(r["t_ns"], r["alt_ft"], r["heading_deg"]) for r in kill_one.truth_between(0, 199)]
+    b = [(r["t_ns"], r["alt_ft"], r["heading_deg"]) for r in hang_one.truth_between(0, 199)]
+    assert len(a) == len(b) > 1900
+    assert a == b
 
 
 def test_replica_with_wrong_output_is_voted_out_and_nothing_else_changes(wrong_output, nominal):

@@ -21,6 +21,13 @@ def _kill(text: str) -> tuple[str, float]:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def _hang(text: str) -> tuple[str, float]:
+    try:
+        return launch_run.parse_kill(text, "--hang-node")
+    except ImaError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def _wrong(text: str) -> tuple[str, str, float, float]:
     try:
         return launch_run.parse_wrong_output(text)
@@ -33,6 +40,11 @@ def add_launch_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--kill-node", type=_kill, action="append", default=[], metavar="NODE@SECONDS",
                         help="stop a whole processor at that emulated time (repeatable), "
                         "e.g. node2@120")
+    parser.add_argument("--hang-node", type=_hang, action="append", default=[],
+                        metavar="NODE@SECONDS",
+                        help="freeze a processor's SKE and partitions at that emulated time "
+                        "(its DDS agent lives on): a hung node, found by the DDS deadline "
+                        "(repeatable)")
     parser.add_argument("--test-wrong-output", type=_wrong, action="append", default=[],
                         metavar="NODE@SECONDS[:AXIS=OFFSET]",
                         help="test switch: that replica's actuator command is offset from then "
@@ -60,7 +72,8 @@ def options_from(args: argparse.Namespace) -> launch_run.LaunchOptions:
     return launch_run.LaunchOptions(
         system=args.system, duration_s=args.duration, seed=args.seed, pilot=args.pilot,
         turbulence=args.turbulence, wind_kt=args.wind, realtime=args.realtime,
-        run_dir=args.run_dir, kill=list(args.kill_node), wrong_output=list(args.test_wrong_output),
+        run_dir=args.run_dir, kill=list(args.kill_node), hang=list(args.hang_node),
+        wrong_output=list(args.test_wrong_output),
         netns=args.netns)
 
 
@@ -89,7 +102,8 @@ def launch_and_summarise(opts: launch_run.LaunchOptions, json_out: bool) -> int:
                 run_dir = holder.get("run_dir")
                 if run_dir is None:
                     return
-                state = holder["state"] = LiveState(run_dir, nodes, dict(opts.kill))
+                state = holder["state"] = LiveState(run_dir, nodes, dict(opts.kill),
+                                                    hangs=dict(opts.hang))
             state.update(st)
             progress.update(task, completed=min(st.get("t_s", 0), opts.duration_s))
             live.update(Group(state.render(), progress))
@@ -99,18 +113,20 @@ def launch_and_summarise(opts: launch_run.LaunchOptions, json_out: bool) -> int:
         holder["run_dir"] = Path(opts.run_dir)
         result = launch_run.launch(opts, on_status=on_status)
     summary = launch_summary.summarise(result.run_dir, pilot, opts.duration_s, result.nodes,
-                                       result.killed, result.wall_s, plot=True)
+                                       result.killed, result.wall_s, plot=True,
+                                       hung=result.hung)
     summary["returncodes"] = result.returncodes
     summary["dds_domain"] = result.domain
     failed = {k: v for k, v in result.returncodes.items()
-              if v not in (0, None) and k.split("/")[0] not in result.killed}
+              if v not in (0, None) and k.split("/")[0] not in {**result.killed, **result.hung}}
     return fly.report(summary, failed, result.run_dir, result.interrupted, json_out, console,
                       print_summary)
 
 
 def print_summary(s: dict, console) -> None:
     fly.print_summary(s, console)
-    killed = ", ".join(f"{k['node']}@{k['t_s']:g}s" for k in s["killed"]) or "none"
+    killed = ", ".join([f"{k['node']}@{k['t_s']:g}s (killed)" for k in s["killed"]]
+                       + [f"{k['node']}@{k['t_s']:g}s (hung)" for k in s.get("hung", [])]) or "none"
     console.print(f"Nodes: {', '.join(s['nodes'])}; stopped on purpose: {killed}")
     vo = ", ".join(f"{v['node']}@{v['t_s']:.3f}s ({v['reason']})" for v in s["voted_out"]) or "none"
     console.print(f"Voted out by the actuators: {vo}; final vote {s.get('vote_status') or '-'}")

@@ -147,6 +147,7 @@ class _Procs:
     def stop(self) -> None:
         """SIGTERM, a grace period, then SIGKILL to whole groups: nothing is left behind."""
         self.signal_all(signal.SIGTERM)
+        self.signal_all(signal.SIGCONT)  # a frozen process takes its SIGTERM now
         self.wait_all(5.0)
         self.signal_all(signal.SIGKILL)
         self.wait_all(5.0)

@@ -52,15 +52,17 @@ class NodeView:
     members: list[str] = field(default_factory=list)
     monitor: str = ""
     killed: bool = False
+    hung: bool = False
 
 
 class LiveState:
     """What the status view shows, updated from the traces (at most every `period_s`)."""
 
     def __init__(self, run_dir: Path, nodes: list[str], kills: dict[str, float],
-                 period_s: float = 0.25) -> None:
+                 period_s: float = 0.25, hangs: dict[str, float] | None = None) -> None:
         self.nodes = {n: NodeView(n, members=list(nodes)) for n in nodes}
         self.kills = kills
+        self.hangs = hangs or {}
         self.period_s = period_s
         self._last = 0.0
         self._followers = {n: Follower(run_dir / f"{n}.jsonl") for n in nodes}
@@ -81,6 +83,8 @@ class LiveState:
             view = self.nodes[name]
             if name in self.kills and t >= self.kills[name]:
                 view.killed = True
+            if name in self.hangs and t >= self.hangs[name]:
+                view.hung = True
             for rec in fol.new_records():
                 kind = rec.get("kind")
                 if kind == "mode" and rec.get("partition"):
@@ -114,8 +118,9 @@ class LiveState:
         for col in ("node", "partitions", "HM events", "membership", "monitor"):
             t.add_column(col)
         for view in self.nodes.values():
-            if view.killed:
-                t.add_row(view.name, "[red]stopped[/]", str(view.hm_events), "-", "-")
+            if view.killed or view.hung:
+                t.add_row(view.name, "[red]stopped[/]" if view.killed else "[red]hung[/]",
+                          str(view.hm_events), "-", "-")
                 continue
             parts = " ".join(f"{p}:{m}" for p, m in sorted(view.modes.items())) or "starting"
             hm = str(view.hm_events) + (f" ({view.last_hm})" if view.last_hm else "")

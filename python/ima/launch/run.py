@@ -11,7 +11,7 @@ Files in the run directory, beyond those of `ima fly` (ima.flight.run):
   nodeK.jsonl    node K's SKE trace (schedule, HM, partition reports: membership, monitor)
   ddsK.jsonl     node K's DDS agent trace (peers alive/lost, deadline misses; wall clock)
   ddsK.json      its statistics (samples, exchange latency)
-  launch.json    how the run was started (system, domain ID, commands, kills)
+  launch.json    how the run was started (system, domain ID, commands, kills, hangs)
 """
 
 from __future__ import annotations
@@ -48,6 +48,7 @@ class LaunchOptions:
     realtime: bool = False
     run_dir: Path | None = None
     kill: list[tuple[str, float]] = field(default_factory=list)  # (node, emulated s)
+    hang: list[tuple[str, float]] = field(default_factory=list)  # (node, emulated s)
     # test-only: (node, axis, offset, from emulated s): that replica's command is wrong
     wrong_output: list[tuple[str, str, float, float]] = field(default_factory=list)
     netns: bool = False
@@ -63,6 +64,7 @@ class LaunchRun:
     interrupted: bool
     killed: dict[str, float]  # node -> emulated time it was stopped at
     domain: int | None
+    hung: dict[str, float] = field(default_factory=dict)  # node -> emulated time it froze at
 
 
 def dds_agent_binary() -> Path:
@@ -72,7 +74,7 @@ def dds_agent_binary() -> Path:
     return path
 
 
-def parse_kill(text: str) -> tuple[str, float]:
+def parse_kill(text: str, option: str = "--kill-node") -> tuple[str, float]:
     """NODE@SECONDS, e.g. node2@120."""
     node, sep, when = text.partition("@")
     try:
@@ -80,14 +82,14 @@ def parse_kill(text: str) -> tuple[str, float]:
     except ValueError:
         t = -1.0
     if not sep or not node or not t >= 0 or t == float("inf"):
-        raise ImaError(f"--kill-node wants NODE@SECONDS (e.g. node2@120), not '{text}'")
+        raise ImaError(f"{option} wants NODE@SECONDS (e.g. node2@120), not '{text}'")
     return node, t
 
 
 def parse_wrong_output(text: str) -> tuple[str, str, float, float]:
     """NODE@SECONDS[:AXIS=OFFSET], e.g. node3@60:elev=0.3 (default elev=0.3)."""
     head, _, spec = text.partition(":")
-    node, t = parse_kill(head)
+    node, t = parse_kill(head, "--test-wrong-output")
     axis, value = "elev", 0.3
     if spec:
         axis, sep, val = spec.partition("=")
@@ -106,14 +108,27 @@ def _log(name: str) -> str:
     return name.replace("/", "-") + ".log"
 
 
+def _frozen(pid: int) -> bool:
+    """Whether the process is stopped by a signal (state T in /proc/PID/stat)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return stat[stat.rfind(")") + 2:][:1] == "T"
+
+
 class _NodeWatch:
     """Stops the run when a process fails, except a node the run kills on purpose: then the
-    rest of that node (its DDS agent) is killed too, as a dead processor's would be."""
+    rest of that node (its DDS agent) is killed too, as a dead processor's would be. Notes
+    when a node the run hangs on purpose is frozen (its agent lives on, as a hung processor's
+    network interface would)."""
 
     def __init__(self, procs: flight._Procs, world: subprocess.Popen, run_dir: Path,
-                 kills: dict[str, float]) -> None:
+                 kills: dict[str, float], hangs: dict[str, float] | None = None) -> None:
         self.procs, self.world, self.run_dir, self.kills = procs, world, run_dir, kills
+        self.hangs = hangs or {}
         self.killed: dict[str, float] = {}
+        self.hung: dict[str, float] = {}
         self.stopping = threading.Event()  # Ctrl-C: the processes end because they are told to
 
     def _expected(self, name: str, code: int | None) -> str | None:
@@ -131,6 +146,9 @@ class _NodeWatch:
                 return  # the run is ending: what exits now follows the bus
             for name, proc in list(procs.procs.items()):
                 code = proc.poll()
+                if name in self.hangs and name not in self.hung and code is None \
+                        and _frozen(proc.pid):
+                    self.hung[name] = self.hangs[name]
                 if name == "world" or code in (None, 0) or name in procs.failed:
                     continue
                 node = self._expected(name, code)
@@ -194,13 +212,20 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
     names = [n.name for n in system.nodes]
     index = {n.name: n.index for n in system.nodes}
     kills: dict[str, float] = {}
-    for node, t in opts.kill:
-        if node not in index:
-            raise ImaError(f"--kill-node {node}@{t:g}: no node '{node}' in {system.path} "
-                           f"(nodes: {', '.join(names)})")
-        if t >= opts.duration_s:
-            raise ImaError(f"--kill-node {node}@{t:g}: after the end of the run ({opts.duration_s:g} s)")
-        kills[node] = min(t, kills.get(node, t))
+    hangs: dict[str, float] = {}
+    for option, faults, chosen in (("--kill-node", opts.kill, kills),
+                                   ("--hang-node", opts.hang, hangs)):
+        for node, t in faults:
+            if node not in index:
+                raise ImaError(f"{option} {node}@{t:g}: no node '{node}' in {system.path} "
+                               f"(nodes: {', '.join(names)})")
+            if t >= opts.duration_s:
+                raise ImaError(f"{option} {node}@{t:g}: after the end of the run "
+                               f"({opts.duration_s:g} s)")
+            chosen[node] = min(t, chosen.get(node, t))
+    both = sorted(set(kills) & set(hangs))
+    if both:
+        raise ImaError(f"{', '.join(both)}: a node is either killed or hung, not both")
     for node, _axis, _v, t in opts.wrong_output:
         if node not in index:
             raise ImaError(f"--test-wrong-output: no node '{node}' in {system.path}")
@@ -232,6 +257,8 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
                "--trace", str(run_dir / "can.jsonl"), "--stats", str(run_dir / "canbus.json"), "-q"]
     for node, t in kills.items():
         bus_cmd += ["--kill-node", f"{index[node]}@{t:g}"]
+    for node, t in hangs.items():
+        bus_cmd += ["--hang-node", f"{index[node]}@{t:g}"]
     # Every node's io partition joins in the first quantum, all at once: fixed indices keep
     # the bus trace the same from run to run.
     bus_cmd += ["--client-order", ",".join([*names, "world", *(f"{n}/io" for n in names)])]
@@ -280,6 +307,7 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
         "wind_kt": opts.wind_kt, "wind_from_deg": opts.wind_from_deg, "realtime": opts.realtime,
         "quantum_us": opts.quantum_us, "dds_domain": domain, "dds_config": str(dds_cfg),
         "kill": [{"node": k, "t_s": t} for k, t in kills.items()],
+        "hang": [{"node": k, "t_s": t} for k, t in hangs.items()],
         "wrong_output": [{"node": a, "axis": b, "offset": c, "t_s": d}
                          for a, b, c, d in opts.wrong_output],
         "netns": opts.netns, "socket": str(sock),
@@ -340,9 +368,18 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
             flight._wait_joined(sock, k, procs, pids=tuple(netns_pids))
         world = procs.start("world", world_cmd, run_dir / "world.log", env=base_env,
                             stdout=subprocess.PIPE)
-        watch = _NodeWatch(procs, world, run_dir, kills)
+        watch = _NodeWatch(procs, world, run_dir, kills, hangs)
         threading.Thread(target=watch, daemon=True).start()
         flight.follow_world(world, on_status)
+        # A hung processor is switched off at the end of the run: its frozen processes would
+        # not even take a SIGTERM. Its agent ends with the others.
+        for node in hangs:
+            proc = procs.procs.get(node)
+            if proc is not None and proc.poll() is None:
+                try:
+                    os.killpg(proc.pid, signal.SIGKILL)
+                except ProcessLookupError:
+                    pass
         deadline = time.monotonic() + flight._GRACE_S
         for name, proc in procs.procs.items():
             if name.endswith("/dds"):
@@ -371,6 +408,7 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
         raise ImaError("the run stopped early: " + "; ".join(
             f"{k} {v}" for k, v in procs.failed.items()) + f" (run directory {run_dir})")
     killed = dict(watch.killed) if watch is not None else {}
+    hung = dict(watch.hung) if watch is not None else {}
     return LaunchRun(run_dir=run_dir, nodes=names, returncodes=codes, wall_s=wall,
-                     interrupted=interrupted, killed=killed, domain=domain)
+                     interrupted=interrupted, killed=killed, domain=domain, hung=hung)
 

@@ -63,15 +63,18 @@ def _dds_stats(run_dir: Path, node_index: int) -> dict | None:
 
 def summarise(run_dir: Path, pilot: Path, duration_s: float, nodes: list[str],
               killed: dict[str, float], wall_s: float | None = None,
-              plot: bool = False) -> dict[str, Any]:
+              plot: bool = False, hung: dict[str, float] | None = None) -> dict[str, Any]:
     """The run's summary (also written to RUN_DIR/summary.json)."""
+    hung = hung or {}
     vote = voting(run_dir)
     events = [(t, f"{k} stopped") for k, t in killed.items()]
+    events += [(t, f"{k} hung") for k, t in hung.items()]
     events += [(v["t_s"], f"{v['node']} voted out") for v in vote["voted_out"]]
     summary = flight_summary.summarise(run_dir, pilot, duration_s, wall_s, nodes=len(nodes),
                                        plot=plot, events=sorted(events))
     summary["nodes"] = list(nodes)
     summary["killed"] = [{"node": k, "t_s": t} for k, t in sorted(killed.items())]
+    summary["hung"] = [{"node": k, "t_s": t} for k, t in sorted(hung.items())]
     summary.update(vote)
     views: dict[str, list[str]] = {}
     membership_events, monitor = [], []
@@ -80,8 +83,8 @@ def summarise(run_dir: Path, pilot: Path, duration_s: float, nodes: list[str],
         membership_events += rep["membership"]
         monitor += rep["monitor"]
         views[node] = rep["membership"][-1]["members"] if rep["membership"] else list(nodes)
-    # The membership the live nodes agree on (a killed node's last view is not a vote).
-    live_views = {n: v for n, v in views.items() if n not in killed}
+    # The membership the live nodes agree on (a killed or hung node's last view is not a vote).
+    live_views = {n: v for n, v in views.items() if n not in killed and n not in hung}
     agreed = sorted({tuple(v) for v in live_views.values()})
     summary["membership"] = list(agreed[0]) if len(agreed) == 1 else None
     summary["membership_agreed"] = len(agreed) == 1

@@ -314,7 +314,11 @@ static void run(agent_t *a)
         if (n < 0 && errno != EINTR)
             break;
         if (n <= 0) {
-            agent_io_check_pending(a, false); /* the real-time wait may be over */
+            /* the real-time wait may be over; a peer may be hung; and, should a listener
+             * call have been missed, what came in meanwhile is taken here */
+            agent_dds_process_events(a);
+            agent_dds_take_all(a);
+            agent_io_check_pending(a, false);
             continue;
         }
         if (p[0].revents)

@@ -17,6 +17,8 @@ from ima.flight import summary as flight_summary
 # The tests import their helpers (flight_helpers.py) from this folder.
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from flight_helpers import fly_unless_host_stalled  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[2]
 DBC = ROOT / "config" / "can" / "rpas.dbc"
 
@@ -53,7 +55,7 @@ class FlightCache:
         if name not in self.flights:
             run_dir = self.base / name
             opts = flight.FlightOptions(run_dir=run_dir, **kw)
-            result = flight.fly(opts)
+            result = fly_unless_host_stalled(lambda: flight.fly(opts), run_dir, name)
             pilot = Path(opts.pilot) if opts.pilot else flight.default_pilot()
             summary = flight_summary.summarise(run_dir, pilot, opts.duration_s, result.wall_s)
             self.flights[name] = Flight(run_dir, summary, result.returncodes)

@@ -21,6 +21,7 @@ from ima.launch import summary as launch_summary
 HERE = Path(__file__).resolve().parent
 sys.path[:0] = [str(HERE), str(HERE.parent / "flight")]
 
+from flight_helpers import fly_unless_host_stalled  # noqa: E402
 from launch_helpers import TRIPLEX  # noqa: E402
 
 
@@ -46,7 +47,8 @@ class LaunchCache:
         if name not in self.runs:
             run_dir = self.base / name
             opts = launch_run.LaunchOptions(system=system, run_dir=run_dir, **kw)
-            result = launch_run.launch(opts, on_status=on_status)
+            result = fly_unless_host_stalled(
+                lambda: launch_run.launch(opts, on_status=on_status), run_dir, name)
             pilot = Path(opts.pilot) if opts.pilot else flight.default_pilot()
             summary = launch_summary.summarise(run_dir, pilot, opts.duration_s, result.nodes,
                                                result.killed, result.wall_s, hung=result.hung)

@@ -167,12 +167,12 @@ def summarise(run_dir: Path, pilot: Path, duration_s: float, wall_s: float | Non
         {"t0_s": s.t0_s, "t1_s": s.t1_s, "heading_deg": s.heading_deg,
          "altitude_ft": s.altitude_ft, "airspeed_kt": s.airspeed_kt} for s in segments]
     summary["mode_changes"] = mode_changes(truth)
-    events = []
+    hm = []
     for k in range(1, nodes + 1):
         for ev in hm_events(run_dir / f"node{k}.jsonl"):
-            events.append(dict(ev, node=f"node{k}"))
-    summary["hm_events"] = len(events)
-    summary["hm_event_list"] = events[:50]
+            hm.append(dict(ev, node=f"node{k}"))
+    summary["hm_events"] = len(hm)
+    summary["hm_event_list"] = hm[:50]
     summary["bus_load"] = bus.get("load")
     summary["bus_load_max_1s"] = bus.get("load_max_1s")
     summary["can_frames"] = bus.get("frames")

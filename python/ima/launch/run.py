@@ -376,6 +376,8 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
         for node in hangs:
             proc = procs.procs.get(node)
             if proc is not None and proc.poll() is None:
+                if _frozen(proc.pid):  # frozen too late in the run for the watch to see it
+                    watch.hung.setdefault(node, hangs[node])
                 try:
                     os.killpg(proc.pid, signal.SIGKILL)
                 except ProcessLookupError:

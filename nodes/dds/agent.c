@@ -316,18 +316,14 @@ static void run(agent_t *a)
         if (n <= 0) {
             /* the real-time wait may be over; a peer may be hung; and, should a listener
              * call have been missed, what came in meanwhile is taken here */
-            agent_dds_process_events(a);
-            agent_dds_take_all(a);
-            agent_io_check_pending(a, false);
+            agent_io_catch_up(a);
             continue;
         }
         if (p[0].revents)
             check_signal(a);
         if (p[1].revents) {
             drain_wake(a);
-            agent_dds_process_events(a);
-            agent_dds_take_all(a);
-            agent_io_check_pending(a, false);
+            agent_io_catch_up(a);
         }
         if (p[2].revents) {
             if (a->io_fd >= 0)

@@ -171,6 +171,8 @@ void agent_io_accept(agent_t *a);
 void agent_io_readable(agent_t *a);
 void agent_io_close(agent_t *a, const char *reason);
 void agent_io_check_pending(agent_t *a, bool timed_out);
+/* The listeners' queued events, the samples that came in, then the pending request. */
+void agent_io_catch_up(agent_t *a);
 void agent_io_shutdown(agent_t *a);
 
 /* agent_out.c: the trace (one JSON object per line) and the statistics. */

@@ -168,6 +168,13 @@ void agent_io_check_pending(agent_t *a, bool timed_out)
     send_agreed(a, missing != 0, missing);
 }
 
+void agent_io_catch_up(agent_t *a)
+{
+    agent_dds_process_events(a);
+    agent_dds_take_all(a);
+    agent_io_check_pending(a, false);
+}
+
 static void on_inputs(agent_t *a, const struct xch_hdr *h, const struct xch_inputs *in)
 {
     if (a->pending) {
@@ -186,9 +193,7 @@ static void on_inputs(agent_t *a, const struct xch_hdr *h, const struct xch_inpu
     a->pend_t_ns = h->t_ns;
     a->pend_start_ns = agent_mono_ns();
     a->pend_waited = false;
-    agent_dds_process_events(a);
-    agent_dds_take_all(a);
-    agent_io_check_pending(a, false);
+    agent_io_catch_up(a);
 }
 
 static void on_dgram(agent_t *a, const unsigned char *buf, long n)

@@ -14,18 +14,14 @@ from ima.launch import run as launch_run
 from ima.launch import summary as launch_summary
 
 
-def _kill(text: str) -> tuple[str, float]:
-    try:
-        return launch_run.parse_kill(text)
-    except ImaError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def _hang(text: str) -> tuple[str, float]:
-    try:
-        return launch_run.parse_kill(text, "--hang-node")
-    except ImaError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+def _node_at(option: str):
+    """The argparse type of a NODE@SECONDS option."""
+    def parse(text: str) -> tuple[str, float]:
+        try:
+            return launch_run.parse_kill(text, option)
+        except ImaError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+    return parse
 
 
 def _wrong(text: str) -> tuple[str, str, float, float]:
@@ -37,10 +33,10 @@ def _wrong(text: str) -> tuple[str, str, float, float]:
 
 def add_launch_arguments(parser: argparse.ArgumentParser) -> None:
     fly.add_flight_arguments(parser)
-    parser.add_argument("--kill-node", type=_kill, action="append", default=[], metavar="NODE@SECONDS",
+    parser.add_argument("--kill-node", type=_node_at("--kill-node"), action="append", default=[], metavar="NODE@SECONDS",
                         help="stop a whole processor at that emulated time (repeatable), "
                         "e.g. node2@120")
-    parser.add_argument("--hang-node", type=_hang, action="append", default=[],
+    parser.add_argument("--hang-node", type=_node_at("--hang-node"), action="append", default=[],
                         metavar="NODE@SECONDS",
                         help="freeze a processor's SKE and partitions at that emulated time "
                         "(its DDS agent lives on): a hung node, found by the DDS deadline "

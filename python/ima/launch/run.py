@@ -119,16 +119,12 @@ def _frozen(pid: int) -> bool:
 
 class _NodeWatch:
     """Stops the run when a process fails, except a node the run kills on purpose: then the
-    rest of that node (its DDS agent) is killed too, as a dead processor's would be. Notes
-    when a node the run hangs on purpose is frozen (its agent lives on, as a hung processor's
-    network interface would)."""
+    rest of that node (its DDS agent) is killed too, as a dead processor's would be."""
 
     def __init__(self, procs: flight._Procs, world: subprocess.Popen, run_dir: Path,
-                 kills: dict[str, float], hangs: dict[str, float] | None = None) -> None:
+                 kills: dict[str, float]) -> None:
         self.procs, self.world, self.run_dir, self.kills = procs, world, run_dir, kills
-        self.hangs = hangs or {}
         self.killed: dict[str, float] = {}
-        self.hung: dict[str, float] = {}
         self.stopping = threading.Event()  # Ctrl-C: the processes end because they are told to
 
     def _expected(self, name: str, code: int | None) -> str | None:
@@ -146,9 +142,6 @@ class _NodeWatch:
                 return  # the run is ending: what exits now follows the bus
             for name, proc in list(procs.procs.items()):
                 code = proc.poll()
-                if name in self.hangs and name not in self.hung and code is None \
-                        and _frozen(proc.pid):
-                    self.hung[name] = self.hangs[name]
                 if name == "world" or code in (None, 0) or name in procs.failed:
                     continue
                 node = self._expected(name, code)
@@ -321,6 +314,7 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
     t0 = time.monotonic()
     previous = {}
     watch: _NodeWatch | None = None
+    hung: dict[str, float] = {}  # node -> emulated time the bus froze it
     netns = None
 
     def on_signal(signum: int, _frame: object) -> None:
@@ -368,7 +362,7 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
             flight._wait_joined(sock, k, procs, pids=tuple(netns_pids))
         world = procs.start("world", world_cmd, run_dir / "world.log", env=base_env,
                             stdout=subprocess.PIPE)
-        watch = _NodeWatch(procs, world, run_dir, kills, hangs)
+        watch = _NodeWatch(procs, world, run_dir, kills)
         threading.Thread(target=watch, daemon=True).start()
         flight.follow_world(world, on_status)
         # A hung processor is switched off at the end of the run: its frozen processes would
@@ -376,8 +370,8 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
         for node in hangs:
             proc = procs.procs.get(node)
             if proc is not None and proc.poll() is None:
-                if _frozen(proc.pid):  # frozen too late in the run for the watch to see it
-                    watch.hung.setdefault(node, hangs[node])
+                if _frozen(proc.pid):  # the bus froze it: it never runs again
+                    hung[node] = hangs[node]
                 try:
                     os.killpg(proc.pid, signal.SIGKILL)
                 except ProcessLookupError:
@@ -410,7 +404,6 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
         raise ImaError("the run stopped early: " + "; ".join(
             f"{k} {v}" for k, v in procs.failed.items()) + f" (run directory {run_dir})")
     killed = dict(watch.killed) if watch is not None else {}
-    hung = dict(watch.hung) if watch is not None else {}
     return LaunchRun(run_dir=run_dir, nodes=names, returncodes=codes, wall_s=wall,
                      interrupted=interrupted, killed=killed, domain=domain, hung=hung)
 

@@ -1,44 +1,28 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The nav_fcs partition: each 50 ms reads the sensor, pilot, actuator and mission ports, runs
- * the navigation and flight-control cores, writes the actuator command, status and solution. */
+/* The nav_fcs partition's APEX main: each period reads the sensor, pilot, actuator and mission
+ * ports, runs the navigation and flight-control cores, writes the actuator command, status and
+ * solution. Its ports and process come from the contract generated from the system model. */
 #include <stdio.h>
 #include <string.h>
 
 #include "ARINC653.h"
 #include "fcs.h"
 #include "nav.h"
+#include "nav_fcs_ports.h"
 #include "rpas/report.h"
 
-#define NAV_FCS_PERIOD_NS 50000000LL
-
-/* Port sizes are the CONTRACT's structs (rpas/ports.h); the module XML must say the same. */
-_Static_assert(sizeof(rpas_gps_msg_t) == 64, "GPS_IN size");
-_Static_assert(sizeof(rpas_ahrs_msg_t) == 88, "AHRS_IN size");
-_Static_assert(sizeof(rpas_air_msg_t) == 40, "AIR_IN size");
-_Static_assert(sizeof(rpas_pilot_msg_t) == 96, "PILOT_IN size");
-_Static_assert(sizeof(rpas_act_status_msg_t) == 48, "ACT_IN size");
-_Static_assert(sizeof(rpas_mission_msg_t) == 56, "MISSION_IN size");
-_Static_assert(sizeof(rpas_act_cmd_msg_t) == 48, "ACT_CMD_OUT size");
-_Static_assert(sizeof(rpas_fcs_status_msg_t) == 72, "FCS_STATUS_OUT size");
-_Static_assert(sizeof(rpas_nav_msg_t) == 112, "NAV_OUT size");
-
-enum { P_GPS, P_AHRS, P_AIR, P_PILOT, P_ACT, P_MISSION, P_ACT_CMD, P_STATUS, P_NAV, P_COUNT };
-
-static const struct {
-    const char *name;
-    MESSAGE_SIZE_TYPE size;
-    PORT_DIRECTION_TYPE dir;
-    SYSTEM_TIME_TYPE refresh_ns;
-} port_cfg[P_COUNT] = {
-    [P_GPS] = {"GPS_IN", sizeof(rpas_gps_msg_t), DESTINATION, 600000000},
-    [P_AHRS] = {"AHRS_IN", sizeof(rpas_ahrs_msg_t), DESTINATION, 100000000},
-    [P_AIR] = {"AIR_IN", sizeof(rpas_air_msg_t), DESTINATION, 200000000},
-    [P_PILOT] = {"PILOT_IN", sizeof(rpas_pilot_msg_t), DESTINATION, 1000000000},
-    [P_ACT] = {"ACT_IN", sizeof(rpas_act_status_msg_t), DESTINATION, 200000000},
-    [P_MISSION] = {"MISSION_IN", sizeof(rpas_mission_msg_t), DESTINATION, 500000000},
-    [P_ACT_CMD] = {"ACT_CMD_OUT", sizeof(rpas_act_cmd_msg_t), SOURCE, 200000000},
-    [P_STATUS] = {"FCS_STATUS_OUT", sizeof(rpas_fcs_status_msg_t), SOURCE, 200000000},
-    [P_NAV] = {"NAV_OUT", sizeof(rpas_nav_msg_t), SOURCE, 200000000},
+/* Port indices: the contract's (nav_fcs_ports.h, generated from the system model). */
+enum {
+    P_GPS = NAV_FCS_PORT_GPS_IN,
+    P_AHRS = NAV_FCS_PORT_AHRS_IN,
+    P_AIR = NAV_FCS_PORT_AIR_IN,
+    P_PILOT = NAV_FCS_PORT_PILOT_IN,
+    P_ACT = NAV_FCS_PORT_ACT_IN,
+    P_MISSION = NAV_FCS_PORT_MISSION_IN,
+    P_ACT_CMD = NAV_FCS_PORT_ACT_CMD_OUT,
+    P_STATUS = NAV_FCS_PORT_FCS_STATUS_OUT,
+    P_NAV = NAV_FCS_PORT_NAV_OUT,
+    P_COUNT = NAV_FCS_PORT_COUNT
 };
 
 /* The partition's state: one instance, owned here; the cores take it by pointer. */
@@ -50,16 +34,19 @@ static struct {
     fcs_inputs_t fcs_in;
 } app;
 
-/* Reads one destination port into msg; true when a whole, VALID message was read. A message
- * that is not valid still updates msg (the cores ignore it). */
+/* Reads one destination port into msg (a struct of the port's size, as the contract checks);
+ * true when a whole, VALID message was read. A message that is not valid still updates msg
+ * (the cores ignore it). */
 static bool read_port(int p, void *msg)
 {
-    unsigned char buf[sizeof(rpas_pilot_msg_t) > 128 ? sizeof(rpas_pilot_msg_t) : 128];
+    unsigned char buf[128];
+    _Static_assert(sizeof(rpas_pilot_msg_t) <= sizeof buf && sizeof(rpas_nav_msg_t) <= sizeof buf,
+                   "read_port's buffer holds every message nav_fcs reads");
     MESSAGE_SIZE_TYPE len = 0;
     VALIDITY_TYPE v = INVALID;
     RETURN_CODE_TYPE rc;
     READ_SAMPLING_MESSAGE(app.port[p], (MESSAGE_ADDR_TYPE)buf, &len, &v, &rc);
-    if (rc != NO_ERROR || len != port_cfg[p].size)
+    if (rc != NO_ERROR || len != nav_fcs_port_spec[p].size)
         return false;
     memcpy(msg, buf, (size_t)len);
     return v == VALID;
@@ -68,7 +55,7 @@ static bool read_port(int p, void *msg)
 static void write_port(int p, const void *msg)
 {
     RETURN_CODE_TYPE rc;
-    WRITE_SAMPLING_MESSAGE(app.port[p], (MESSAGE_ADDR_TYPE)msg, port_cfg[p].size, &rc);
+    WRITE_SAMPLING_MESSAGE(app.port[p], (MESSAGE_ADDR_TYPE)msg, nav_fcs_port_spec[p].size, &rc);
 }
 
 static const char *mode_name(uint32_t m)
@@ -133,25 +120,26 @@ int main(void)
 {
     RETURN_CODE_TYPE rc;
     for (int p = 0; p < P_COUNT; p++) {
-        CREATE_SAMPLING_PORT(port_cfg[p].name, port_cfg[p].size, port_cfg[p].dir, port_cfg[p].refresh_ns,
-                             &app.port[p], &rc);
+        const rpas_port_spec_t *ps = &nav_fcs_port_spec[p];
+        CREATE_SAMPLING_PORT((char *)ps->name, ps->size, ps->direction, ps->refresh_ns, &app.port[p], &rc);
         if (rc != NO_ERROR) {
-            fail(port_cfg[p].name, rc);
+            fail(ps->name, rc);
             return 1;
         }
     }
     nav_init(&app.nav, NULL);
     fcs_init(&app.fcs, NULL);
 
+    const rpas_process_spec_t *ps = &nav_fcs_process_spec[NAV_FCS_PROCESS_NAV_FCS];
     PROCESS_ATTRIBUTE_TYPE attr = {
-        .PERIOD = NAV_FCS_PERIOD_NS,
-        .TIME_CAPACITY = NAV_FCS_PERIOD_NS,
+        .PERIOD = ps->period_ns,
+        .TIME_CAPACITY = ps->period_ns,
         .ENTRY_POINT = (SYSTEM_ADDRESS_TYPE)cycle,
-        .STACK_SIZE = 262144,
-        .BASE_PRIORITY = 100,
-        .DEADLINE = HARD,
-        .NAME = "nav_fcs",
+        .STACK_SIZE = ps->stack_size,
+        .BASE_PRIORITY = ps->priority,
+        .DEADLINE = ps->deadline,
     };
+    snprintf(attr.NAME, sizeof attr.NAME, "%s", ps->name);
     PROCESS_ID_TYPE pid;
     CREATE_PROCESS(&attr, &pid, &rc);
     if (rc != NO_ERROR) {

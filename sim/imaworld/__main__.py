@@ -4,11 +4,12 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from ima.errors import ImaError
 
-from .config import DEFAULT
+from .config import VotingParams
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -32,16 +33,18 @@ def build_parser() -> argparse.ArgumentParser:
                     help="elevation of the flat terrain (ft MSL, default 500)")
     ap.add_argument("--channels", type=int, choices=(1, 2, 3), default=None,
                     help="flight-control replicas commanding the actuators on ACT_CMD_A..; "
-                    "given, the actuators vote over them (default: one, not voted: the "
-                    "lowest live channel is used)")
+                    "given, the actuators vote over them as the four --vote-* options say "
+                    "(default: one, not voted: the lowest live channel is used)")
     ap.add_argument("--vote-threshold", default=None, metavar="ELEV,AIL,RUD,THR",
-                    help="miscompare thresholds of the vote per axis, normalised (default "
-                    "0.1,0.1,0.1,0.1)")
+                    help="miscompare thresholds of the vote per axis, normalised (the system "
+                    "model's voting.thresholds)")
     ap.add_argument("--vote-persist", type=int, default=None, metavar="N",
-                    help="consecutive bad votes before a channel is voted out (default 3)")
+                    help="consecutive bad votes before a channel is voted out (voting.persist)")
     ap.add_argument("--vote-offset", type=float, default=None, metavar="S",
-                    help="when the actuators vote in each 50 ms major frame, in seconds from "
-                    "its start (default 0.045)")
+                    help="when the actuators vote in each frame, in seconds from its start "
+                    "(voting.offset_s)")
+    ap.add_argument("--vote-period", type=float, default=None, metavar="S",
+                    help="the voting frame: the system's major frame (schedule.major_frame_s)")
     ap.add_argument("--status", action="store_true",
                     help="print one JSON progress line per emulated second on stdout")
     ap.add_argument("--name", default="world", help="client name on the bus")
@@ -60,34 +63,43 @@ def main(argv: list[str] | None = None) -> int:
         return e.exit_code
 
 
+_VOTE_OPTIONS = ("vote_threshold", "vote_persist", "vote_offset", "vote_period")
+
+
 def vote_options(args) -> dict:
-    """The voting options as World Options fields; ImaError (exit 2) when one is bad."""
-    out: dict = {"channels": args.channels}
-    given = [f"--{k.replace('_', '-')}" for k in ("vote_threshold", "vote_persist", "vote_offset")
-             if getattr(args, k) is not None]
-    if given and args.channels is None:
-        raise ImaError(f"{', '.join(given)}: only with --channels (without it nothing is "
-                       "voted)", exit_code=2)
+    """The voting options as World Options fields; ImaError (exit 2) when one is bad. The
+    world has no voting settings of its own: with --channels every --vote-* option is given
+    (ima launch passes the system model's)."""
+    given = [f"--{k.replace('_', '-')}" for k in _VOTE_OPTIONS if getattr(args, k) is not None]
+    if args.channels is None:
+        if given:
+            raise ImaError(f"{', '.join(given)}: only with --channels (without it nothing is "
+                           "voted)", exit_code=2)
+        return {"channels": None, "voting": None}
+    thr: tuple = ()
     if args.vote_threshold is not None:
         try:
             thr = tuple(float(x) for x in args.vote_threshold.split(","))
         except ValueError:
             thr = ()
-        if len(thr) != 4 or not all(x >= 0 for x in thr):  # also refuses NaN
+        if len(thr) != 4 or not all(0 <= x < math.inf for x in thr):  # also refuses NaN
             raise ImaError(f"--vote-threshold {args.vote_threshold!r}: expected four numbers "
                            ">= 0, elev,ail,rud,thr", exit_code=2)
-        out["vote_threshold"] = thr
-    if args.vote_persist is not None:
-        if args.vote_persist < 1:
-            raise ImaError("--vote-persist must be at least 1", exit_code=2)
-        out["vote_persist"] = args.vote_persist
-    if args.vote_offset is not None:
-        period_s = DEFAULT.voting.period_ms / 1000
-        if not 0 <= args.vote_offset < period_s:  # also refuses NaN
-            raise ImaError(f"--vote-offset {args.vote_offset:g}: must be within the "
-                           f"{period_s:g} s major frame, 0 <= S < {period_s:g}", exit_code=2)
-        out["vote_offset_s"] = args.vote_offset
-    return out
+    if args.vote_persist is not None and args.vote_persist < 1:
+        raise ImaError("--vote-persist must be at least 1", exit_code=2)
+    period = args.vote_period
+    if period is not None and not 0 < period < math.inf:
+        raise ImaError(f"--vote-period {period:g}: must be a positive number of seconds",
+                       exit_code=2)
+    if args.vote_offset is not None and period is not None and not 0 <= args.vote_offset < period:
+        raise ImaError(f"--vote-offset {args.vote_offset:g}: must be within the {period:g} s "
+                       f"major frame, 0 <= S < {period:g}", exit_code=2)
+    missing = [f"--{k.replace('_', '-')}" for k in _VOTE_OPTIONS if getattr(args, k) is None]
+    if missing:
+        raise ImaError(f"--channels {args.channels}: the vote needs {', '.join(missing)} too "
+                       "(the system model's voting; ima launch passes them)", exit_code=2)
+    return {"channels": args.channels,
+            "voting": VotingParams(thr, args.vote_persist, args.vote_offset, period)}
 
 
 def run(args) -> int:

@@ -16,7 +16,7 @@ CHANNELS = ("A", "B", "C")
 
 
 class CommandSelector:
-    """Where the redundancy-management voter plugs in (DESIGN.md §3).
+    """Where the redundancy-management voter plugs in (docs/redundancy.md).
 
     The actuators call `update()` for every ACT_CMD_x frame and `select()` once per physics
     step; `select()` returns (command, channel label) or (None, None) when no channel is fresh.
@@ -58,7 +58,7 @@ class LowestLiveChannel(CommandSelector):
 
 
 class VotingSelector(CommandSelector):
-    """The smart actuators' voter (DESIGN.md §3): the C voter (nodes/include/voter/voter.h,
+    """The smart actuators' voter (docs/redundancy.md): the C voter (nodes/include/voter/voter.h,
     through imaworld.voter) over channels A.. of the n configured, dim 4 (elev, ail, rud, thr).
 
     Voting frames come once per major frame, at `offset_ns` into it (k * period + offset). A
@@ -77,9 +77,8 @@ class VotingSelector(CommandSelector):
 
     latches_safe = True
 
-    def __init__(self, n_channels: int, thresholds=(0.1, 0.1, 0.1, 0.1), persist: int = 3,
-                 offset_ns: int = 45_000_000, period_ns: int = 50_000_000,
-                 safe=(0.0, 0.0, 0.0, 0.0)) -> None:
+    def __init__(self, n_channels: int, thresholds: tuple, persist: int, offset_ns: int,
+                 period_ns: int, safe=(0.0, 0.0, 0.0, 0.0)) -> None:
         if not 0 <= offset_ns < period_ns:
             raise ValueError(f"vote offset {offset_ns} ns is not within the {period_ns} ns frame")
         super().__init__(n_channels)

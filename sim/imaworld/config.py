@@ -67,12 +67,13 @@ class ActuatorParams:
 
 @dataclass(frozen=True)
 class VotingParams:
-    """The smart actuators' voter, used when the world is told how many channels there are."""
-    period_ms: int = 50  # one voting frame per major frame ...
-    offset_s: float = 0.045  # ... at this offset into it: votes at k * period + offset
-    thresholds: tuple = (0.1, 0.1, 0.1, 0.1)  # |x - voted| above this is a miscompare (elev,
-    # ail, rud, thr; normalised units)
-    persist: int = 3  # consecutive bad votes (miscompare or absent) before a channel is out
+    """How the smart actuators vote over the flight-control replicas: the system model's
+    `voting` section and its major frame, which the launcher passes on (the world has no
+    voting settings of its own). Votes are taken at k * period + offset."""
+    thresholds: tuple  # |x - voted| above this is a miscompare (elev, ail, rud, thr; normalised)
+    persist: int  # consecutive bad votes (miscompare or absent) before a channel is out
+    offset_s: float  # when in each voting frame the vote is taken
+    period_s: float  # one voting frame per major frame
 
 
 @dataclass(frozen=True)
@@ -106,7 +107,6 @@ class WorldParams:
     ahrs: AhrsParams = field(default_factory=AhrsParams)
     adc: AdcParams = field(default_factory=AdcParams)
     actuators: ActuatorParams = field(default_factory=ActuatorParams)
-    voting: VotingParams = field(default_factory=VotingParams)
     station: StationParams = field(default_factory=StationParams)
     atmosphere: AtmosphereParams = field(default_factory=AtmosphereParams)
     limits: LimitParams = field(default_factory=LimitParams)

@@ -7,7 +7,7 @@ import json
 import math
 import sys
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 from ima.canbus import proto
@@ -17,7 +17,7 @@ from .actuators import CHANNELS, Actuators, LowestLiveChannel, VotingSelector, s
 from .config import DEFAULT, NS, VotingParams, WorldParams
 from .fdm import Aircraft
 from .pilot import LAT_MODE_CODES, MODE_CODES, VERT_MODE_CODES, PilotScript
-from .sensors import AirData, Ahrs, Gps
+from .sensors import Ahrs, AirData, Gps
 
 INF = 1 << 62
 
@@ -46,12 +46,10 @@ class Options:
     terrain_ft: float = 500.0
     status: bool = False
     # Flight-control replicas commanding the actuators (ACT_CMD_A..), 1..3: the actuators
-    # vote over them (with these overrides of WorldParams.voting). None: not told, so one
+    # vote over them as `voting` says (required with channels). None: not told, so one
     # replica, simplex: the lowest live channel is used, nothing is voted.
     channels: int | None = None
-    vote_threshold: tuple | None = None  # (elev, ail, rud, thr)
-    vote_persist: int | None = None
-    vote_offset_s: float | None = None
+    voting: VotingParams | None = None
 
 
 def _r(x: float, n: int) -> float | None:
@@ -90,9 +88,9 @@ class World:
             raise ValueError(f"unknown turbulence {turb!r}")
         self.ac.set_turbulence(*params.atmosphere.turbulence[turb])
         tr = self.trim
-        self.voting = self._voting_params(params.voting, opts)
+        self.voting = opts.voting
         self.act = Actuators(params.actuators, (tr["elev"], tr["ail"], tr["rud"], tr["thr"]),
-                             self._selector(opts.channels, self.voting, params))
+                             self._selector(opts.channels, opts.voting, params))
         self.ac.set_controls(*self.act.pos)
         self.gps = Gps(params.gps, seed)
         self.ahrs = Ahrs(params.ahrs, seed)
@@ -129,24 +127,16 @@ class World:
         self._tasks = self._make_tasks()
 
     @staticmethod
-    def _voting_params(vp: VotingParams, opts: Options) -> VotingParams:
-        if opts.vote_threshold is not None:
-            vp = replace(vp, thresholds=tuple(float(x) for x in opts.vote_threshold))
-        if opts.vote_persist is not None:
-            vp = replace(vp, persist=opts.vote_persist)
-        if opts.vote_offset_s is not None:
-            vp = replace(vp, offset_s=opts.vote_offset_s)
-        return vp
-
-    @staticmethod
-    def _selector(channels: int | None, vp: VotingParams, params: WorldParams):
+    def _selector(channels: int | None, vp: VotingParams | None, params: WorldParams):
         if channels is None:
             return LowestLiveChannel()
         if channels not in (1, 2, 3):
             raise ValueError(f"channels must be 1, 2 or 3, not {channels!r}")
-        period = vp.period_ms * 1_000_000
-        return VotingSelector(channels, vp.thresholds, vp.persist, round(vp.offset_s * NS),
-                              period, safe_position(params.actuators))
+        if vp is None:
+            raise ValueError("voted channels need the voting parameters (Options.voting)")
+        return VotingSelector(channels, tuple(vp.thresholds), vp.persist,
+                              round(vp.offset_s * NS), round(vp.period_s * NS),
+                              safe_position(params.actuators))
 
     # -- output --------------------------------------------------------------------------
     def event(self, src: str, kind: str, t_ns: int | None = None, **fields) -> None:
@@ -405,7 +395,8 @@ class World:
             return None
         vp = self.voting
         return {**sel.summary(), "thresholds": [_r(x, 6) for x in vp.thresholds],
-                "persist": vp.persist, "offset_s": vp.offset_s, "period_ms": vp.period_ms}
+                "persist": vp.persist, "offset_s": vp.offset_s,
+                "period_ms": round(vp.period_s * 1000, 6)}
 
     def finish(self, wall_s: float) -> None:
         self._log_actuators()

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """`ima deploy`: the checked-in output of the triplex is what the generator writes, byte for
-byte; node1's module is the hand-written rpas_node.xml (plus io's APPLICATION_ERROR entry);
-modules validate; the C glue compiles; the command prints its summary and reports errors."""
+byte; the nodes differ by what the model says differs (their names and io's arguments);
+modules validate; the C glue compiles and checks the message types; the command prints its
+summary and reports errors."""
 
 from __future__ import annotations
 
@@ -26,7 +27,7 @@ from ima.errors import ImaError
 ROOT = Path(__file__).resolve().parents[2]
 TRIPLEX = ROOT / "config" / "systems" / "rpas_triplex.yaml"
 SIMPLEX = ROOT / "config" / "systems" / "rpas_simplex.yaml"
-HAND_WRITTEN = ROOT / "config" / "nodes" / "rpas_node.xml"
+PARTITIONS_INCLUDE = ROOT / "partitions" / "include"
 GOLDEN = Path(__file__).resolve().parent / "golden" / "rpas_triplex"
 XSD = ROOT / "config" / "schema" / "ima653_module.xsd"
 APEX_INCLUDE = ROOT / "ske" / "apex" / "include"
@@ -144,16 +145,31 @@ def test_each_replica_sends_on_its_own_redundancy_channel(triplex: DeployResult)
         assert {"FCS_STATUS_A", "FCS_STATUS_B", "FCS_STATUS_C"} <= set(p["can_receives"])
 
 
-def test_the_nodes_differ_only_by_name(triplex: DeployResult) -> None:
+def test_the_nodes_differ_only_by_name_and_io_arguments(triplex: DeployResult) -> None:
     base = _without_node(_facts(triplex.modules["node1"]))
-    for node, path in triplex.modules.items():
+    for k, (node, path) in enumerate(triplex.modules.items(), start=1):
         facts = _facts(path)
         assert facts["node"] == node
         assert _without_node(facts) == base
+        assert facts["partitions"]["io"]["program"] == ("io", " ".join([
+            f"--node={node}", f"--node-index={k}", "--nodes=1,2,3", "--canbus=can.sock",
+            f"--dds=dds{k}.sock", "--vote-thresholds=0.1,0.1,0.1,0.1", "--vote-persist=3",
+            "--membership-missed-frames=2"]))
+        assert facts["partitions"]["nav_fcs"]["program"] == ("nav_fcs", None)
 
 
 def _without_node(facts: dict) -> dict:
-    return {k: v for k, v in facts.items() if k != "node"}
+    """A module's facts without what differs from node to node: its name, io's arguments."""
+    parts = {name: {**p, "program": p["program"][0]} for name, p in facts["partitions"].items()}
+    return {k: v for k, v in facts.items() if k != "node"} | {"partitions": parts}
+
+
+def test_a_run_adds_test_switches_to_one_node_only(tmp_path: Path) -> None:
+    result = generate(load_system(TRIPLEX), tmp_path,
+                      extra_arguments={("node2", "io"): ["--test-cmd-bias=elev=0.3@60"]})
+    args = {n: _facts(p)["partitions"]["io"]["program"][1] for n, p in result.modules.items()}
+    assert args["node2"].endswith(" --membership-missed-frames=2 --test-cmd-bias=elev=0.3@60")
+    assert "--test-cmd-bias" not in args["node1"] + args["node3"]
 
 
 def test_simplex_deploys_one_module(tmp_path: Path) -> None:
@@ -166,8 +182,21 @@ def test_simplex_deploys_one_module(tmp_path: Path) -> None:
 
 
 def test_simplex_and_triplex_run_the_same_node(triplex: DeployResult, tmp_path: Path) -> None:
+    """One partition set (config/applications/rpas.yaml): node1 is the same node in both
+    systems; io alone learns from its arguments that it has no other node."""
     simplex = generate(load_system(SIMPLEX), tmp_path)
-    assert _facts(simplex.modules["node1"]) == _facts(triplex.modules["node1"])
+    one, three = _facts(simplex.modules["node1"]), _facts(triplex.modules["node1"])
+    assert _without_node(one) == _without_node(three)
+    args = [a.split() for a in (one["partitions"]["io"]["program"][1],
+                                three["partitions"]["io"]["program"][1])]
+    assert [a for a in args[0] if a not in args[1]] == ["--nodes=1"]
+    assert [a for a in args[1] if a not in args[0]] == ["--nodes=1,2,3"]
+    # ... and the partitions' contract is the same: one program serves both systems
+    for name in ("io_ports.h", "nav_fcs_ports.h"):
+        a = (tmp_path / "glue" / name).read_text().splitlines()
+        b = (triplex.out_dir / "glue" / name).read_text().splitlines()
+        assert [x for x in a[1:] if "CAN on node" not in x and "system rpas_" not in x] == \
+               [x for x in b[1:] if "CAN on node" not in x and "system rpas_" not in x]
 
 
 def test_a_smaller_system_removes_what_a_bigger_one_wrote(tmp_path: Path) -> None:
@@ -178,7 +207,7 @@ def test_a_smaller_system_removes_what_a_bigger_one_wrote(tmp_path: Path) -> Non
     assert (tmp_path / "notes.xml").read_text() == "<mine/>\n"  # not ours: left alone
 
 
-# --- node1 is the hand-written module --------------------------------------------------------
+# --- what a module configures ------------------------------------------------------------------
 
 def _seconds(text: str | None) -> Decimal | None:
     return None if text is None else Decimal(text)
@@ -258,19 +287,6 @@ def _facts(path: Path) -> dict:
     }
 
 
-def test_node1_is_the_hand_written_node_module(triplex: DeployResult) -> None:
-    got = _facts(triplex.modules["node1"])
-    want = _facts(HAND_WRITTEN)
-    # The one intended difference: io records an APPLICATION_ERROR (2) in state PROCESS (2)
-    # instead of being idled by the default.
-    ident, io_table = want["partition_hm"]["io"]
-    assert (2, 2) not in io_table
-    want["partition_hm"]["io"] = (ident, {**io_table, (2, 2): "IGNORE"})
-    for key in want:
-        assert got[key] == want[key], f"{key} differs from config/nodes/rpas_node.xml"
-    assert got == want
-
-
 def test_io_records_an_application_error_instead_of_being_idled(triplex) -> None:
     """The SKE's rule: no error handler -> the partition level decides, from io's table."""
     facts = _facts(triplex.modules["node1"])
@@ -327,7 +343,9 @@ CC = shutil.which("cc")
 def test_each_header_compiles_on_its_own(triplex: DeployResult) -> None:
     for header in triplex.glue:
         done = subprocess.run([CC, "-std=c11", "-fsyntax-only", "-Wall", "-Wextra", "-Werror",
-                               "-pedantic", "-x", "c", "-I", str(header.parent), str(header)],
+                               "-pedantic", "-x", "c", "-I", str(header.parent),
+                               "-I", str(APEX_INCLUDE), "-I", str(PARTITIONS_INCLUDE),
+                               str(header)],
                               capture_output=True, text=True)
         assert done.returncode == 0, f"{header.name}:\n{done.stderr}"
 
@@ -355,9 +373,38 @@ def test_a_partition_can_use_the_glue_with_apex(triplex: DeployResult, tmp_path:
         "    (void)a; (void)nodes; (void)channels;\n"
         "}\n")
     done = subprocess.run([CC, "-std=c11", "-fsyntax-only", "-Wall", "-Wextra", "-Werror",
-                           "-I", str(triplex.out_dir / "glue"), "-I", str(APEX_INCLUDE), str(src)],
+                           "-I", str(triplex.out_dir / "glue"), "-I", str(APEX_INCLUDE),
+                           "-I", str(PARTITIONS_INCLUDE), str(src)],
                           capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler")
+def test_a_message_type_of_another_size_fails_the_build(tmp_path: Path) -> None:
+    """The port contract checks each message struct against its port's size in the model."""
+    import yaml
+
+    app = yaml.safe_load((ROOT / "config" / "applications" / "rpas.yaml").read_text())
+    for section, key in (("can", "dbc"), ("dds", "config")):
+        app["channels"][section][key] = str(ROOT / "config" / "applications" /
+                                            app["channels"][section][key])
+    for p in app["partitions"]:
+        for port in p["ports"]:
+            if port["name"] in ("GPS_OUT", "GPS_IN"):
+                port["size"] = 72  # rpas_gps_msg_t is 64 bytes
+    (tmp_path / "app.yaml").write_text(yaml.safe_dump(app))
+    (tmp_path / "sys.yaml").write_text("include: app.yaml\nsystem: s\n"
+                                       "nodes: [{name: node1, index: 1}]\n")
+    out = tmp_path / "out"
+    generate(load_system(tmp_path / "sys.yaml"), out)
+    src = tmp_path / "use.c"
+    src.write_text('#include "io_ports.h"\n')
+    done = subprocess.run([CC, "-std=c11", "-fsyntax-only", "-I", str(out / "glue"),
+                           "-I", str(APEX_INCLUDE), "-I", str(PARTITIONS_INCLUDE), str(src)],
+                          capture_output=True, text=True)
+    assert done.returncode != 0
+    assert "io.GPS_OUT: sizeof(rpas_gps_msg_t) differs from the port size in the model (72)" \
+        in done.stderr
 
 
 # --- the command -----------------------------------------------------------------------------
@@ -423,8 +470,7 @@ def test_command_on_a_missing_file_says_so(tmp_path: Path) -> None:
 def test_command_on_a_bad_model_names_the_value(tmp_path: Path) -> None:
     bad = tmp_path / "bad.yaml"
     text = TRIPLEX.read_text().replace("{name: node2, index: 2}", "{name: node2, index: 7}")
-    bad.write_text(text.replace("../can/", f"{ROOT}/config/can/")
-                   .replace("../dds/", f"{ROOT}/config/dds/"))
+    bad.write_text(text.replace("../applications/", f"{ROOT}/config/applications/"))
     line = next(i for i, ln in enumerate(text.splitlines(), 1) if "index: 7" in ln)
     done = _ima("deploy", str(bad), "-o", str(tmp_path / "out"))
     assert done.returncode == 2

@@ -20,7 +20,10 @@ TRIPLEX = ROOT / "config" / "systems" / "rpas_triplex.yaml"
 
 @pytest.fixture(scope="module")
 def good() -> dict:
+    """The triplex model in one file: the system file with the application it includes."""
     doc = yaml.safe_load(TRIPLEX.read_text())
+    included = TRIPLEX.parent / doc.pop("include")
+    doc.update(yaml.safe_load(included.read_text()))
     # The copies live in a temporary folder: point them at the repository's bus files.
     doc["channels"]["can"]["dbc"] = str(ROOT / "config" / "can" / "rpas.dbc")
     doc["channels"]["dds"]["config"] = str(ROOT / "config" / "dds" / "cyclonedds-loopback.xml")
@@ -49,8 +52,11 @@ def line_of(msg: str) -> int:
 
 
 def test_the_models_load() -> None:
-    load_system(TRIPLEX)
-    load_system(ROOT / "config" / "systems" / "rpas_simplex.yaml")
+    triplex = load_system(TRIPLEX)
+    simplex = load_system(ROOT / "config" / "systems" / "rpas_simplex.yaml")
+    # one partition set, included by both
+    assert triplex.included == simplex.included == [ROOT / "config" / "applications" / "rpas.yaml"]
+    assert triplex.partitions == simplex.partitions
 
 
 # --- the schema ------------------------------------------------------------------------------
@@ -133,7 +139,7 @@ def test_several_errors_are_listed_with_their_lines(tmp_path, good) -> None:
         d["voting"]["persist"] = 0
 
     msg, _ = refuse(tmp_path, good, edit)
-    assert "nodes[1].index: 7 is greater than the maximum of 3; line " in msg
+    assert f"nodes[1].index: 7 is greater than the maximum of 3; {tmp_path / 'system.yaml'}:" in msg
     assert ": voting.persist: 0 is less than the minimum of 1" in msg
 
 
@@ -145,11 +151,65 @@ def test_a_whole_number_version_is_a_version(tmp_path, good) -> None:
     assert load_system(path).version == "2"
 
 
+APPLICATION = ROOT / "config" / "applications" / "rpas.yaml"
+
+
+def _included(tmp_path: Path, app_text: str, system_text: str | None = None) -> Path:
+    """A copy of the triplex (system file and application) in tmp_path, the application's
+    text given; returns the system file."""
+    (tmp_path / "applications").mkdir()
+    (tmp_path / "applications" / "rpas.yaml").write_text(
+        app_text.replace("../can/", f"{ROOT}/config/can/").replace("../dds/", f"{ROOT}/config/dds/"))
+    (tmp_path / "systems").mkdir()
+    path = tmp_path / "systems" / "rpas_triplex.yaml"
+    path.write_text(system_text if system_text is not None else TRIPLEX.read_text())
+    return path
+
+
 def test_a_key_given_twice(tmp_path) -> None:
+    path = _included(tmp_path, APPLICATION.read_text().replace("  persist: 3\n",
+                                                               "  persist: 3\n  persist: 4\n"))
+    app = tmp_path / "applications" / "rpas.yaml"
+    line = app.read_text().splitlines().index("  persist: 4") + 1
+    with pytest.raises(ImaError, match=rf"^{app}:{line}: voting: key 'persist' appears twice$"):
+        load_system(path)
+
+
+def test_an_error_in_the_included_file_names_that_file(tmp_path) -> None:
+    text = APPLICATION.read_text().replace("  persist: 3\n", "  persist: 0\n")
+    path = _included(tmp_path, text)
+    app = tmp_path / "applications" / "rpas.yaml"
+    line = text.splitlines().index("  persist: 0") + 1
+    with pytest.raises(ImaError, match=rf"^{app}:{line}: voting.persist: 0 is less than the "
+                                       "minimum of 1$"):
+        load_system(path)
+
+
+def test_a_key_in_both_files(tmp_path) -> None:
+    system = TRIPLEX.read_text() + "voting: {thresholds: {elev: 1}, persist: 1, offset_s: 0}\n"
+    path = _included(tmp_path, APPLICATION.read_text(), system)
+    app = tmp_path / "applications" / "rpas.yaml"
+    app_line = app.read_text().splitlines().index("voting:") + 1
+    line = system.splitlines().index("voting: {thresholds: {elev: 1}, persist: 1, offset_s: 0}") + 1
+    with pytest.raises(ImaError, match=rf"^{path}:{line}: voting: also written in "
+                                       rf"{app}:{app_line}: a key is written in one file only$"):
+        load_system(path)
+
+
+def test_an_included_file_includes_nothing(tmp_path) -> None:
+    path = _included(tmp_path, "include: other.yaml\n" + APPLICATION.read_text())
+    with pytest.raises(ImaError, match=r"rpas.yaml:1: include: an included file includes "
+                                       "nothing further$"):
+        load_system(path)
+
+
+def test_an_include_that_is_not_there(tmp_path) -> None:
     path = tmp_path / "system.yaml"
-    path.write_text(TRIPLEX.read_text().replace("  persist: 3\n", "  persist: 3\n  persist: 4\n"))
-    line = path.read_text().splitlines().index("  persist: 4") + 1
-    with pytest.raises(ImaError, match=rf"^{path}:{line}: voting: key 'persist' appears twice$"):
+    path.write_text("include: nope.yaml\nsystem: s\n")
+    with pytest.raises(ImaError, match=rf"^{path}:1: include: no such file: {tmp_path}/nope.yaml$"):
+        load_system(path)
+    path.write_text("include: [a.yaml]\nsystem: s\n")
+    with pytest.raises(ImaError, match=rf"^{path}:1: include: expected the path of a YAML file"):
         load_system(path)
 
 

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Fixtures of the flight tests: real flights (JSBSim world, CAN bus, one ima-ske node) run
-once per session and shared by the tests that judge them from the world's truth trace."""
+"""Fixtures of the flight tests: real flights (JSBSim world, CAN bus, one ima-ske node: the
+one-node system `ima fly` launches) run once per session and shared by the tests that judge
+them from the world's truth trace."""
 
 from __future__ import annotations
 
@@ -11,8 +12,9 @@ from pathlib import Path
 import cantools
 import pytest
 
-from ima.flight import run as flight
 from ima.flight import summary as flight_summary
+from ima.launch import options as launch_options
+from ima.launch import run as launch_run
 
 # The tests import their helpers (flight_helpers.py) from this folder.
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -51,12 +53,15 @@ class FlightCache:
         self.base = base
         self.flights: dict[str, Flight] = {}
 
-    def fly(self, name: str, **kw) -> Flight:
+    def fly(self, name: str, system: Path | None = None, **kw) -> Flight:
+        """`ima fly`: the one-node system (or `system`) launched."""
         if name not in self.flights:
             run_dir = self.base / name
-            opts = flight.FlightOptions(run_dir=run_dir, **kw)
-            result = fly_unless_host_stalled(lambda: flight.fly(opts), run_dir, name)
-            pilot = Path(opts.pilot) if opts.pilot else flight.default_pilot()
+            opts = launch_options.LaunchOptions(
+                system=system or launch_options.system_path("rpas_simplex"), run_dir=run_dir,
+                kind="fly", **kw)
+            result = fly_unless_host_stalled(lambda: launch_run.launch(opts), run_dir, name)
+            pilot = Path(opts.pilot) if opts.pilot else launch_options.default_pilot()
             summary = flight_summary.summarise(run_dir, pilot, opts.duration_s, result.wall_s)
             self.flights[name] = Flight(run_dir, summary, result.returncodes)
         return self.flights[name]

@@ -1,13 +1,14 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Helpers of the flight tests: a node module with a stand-in mission manager, failure dumps."""
+"""Helpers of the flight tests: a system with a stand-in mission manager, failure dumps."""
 
 from __future__ import annotations
 
 import json
 import shutil
 import warnings
-import xml.etree.ElementTree as ET
 from pathlib import Path
+
+import yaml
 
 ROOT = Path(__file__).resolve().parents[2]
 PILOTS = ROOT / "sim" / "pilots"
@@ -24,42 +25,40 @@ def within(summary: dict, bounds: dict) -> list[str]:
             if summary.get(k) is None or summary[k] > v]
 
 
-def mission_node_module(dest: Path, feed_args: str) -> Path:
-    """The flight node plus a stand-in mission manager (partition mission_feed) writing
+def scratch_system(dest: Path, edit, nodes: int = 1) -> Path:
+    """A system model in `dest` that is the shipped RPAS application (config/applications/
+    rpas.yaml) changed by `edit(application_dict)`, on `nodes` nodes: the model is the only
+    place a test changes a deployment. Returns the system file."""
+    app = yaml.safe_load((ROOT / "config" / "applications" / "rpas.yaml").read_text())
+    for section, key in (("can", "dbc"), ("dds", "config")):
+        app["channels"][section][key] = str(ROOT / "config" / "applications" /
+                                            app["channels"][section][key])
+    edit(app)
+    dest.mkdir(parents=True, exist_ok=True)
+    (dest / "application.yaml").write_text(yaml.safe_dump(app, sort_keys=False))
+    system = {"include": "application.yaml", "system": "scratch",
+              "nodes": [{"name": f"node{k}", "index": k} for k in range(1, nodes + 1)]}
+    path = dest / "system.yaml"
+    path.write_text(yaml.safe_dump(system, sort_keys=False))
+    return path
+
+
+def mission_system(dest: Path, feed_args: list[str]) -> Path:
+    """The one-node system plus a stand-in mission manager (partition mission_feed) writing
     MISSION targets to nav_fcs in the free part of the major frame."""
-    ns = "urn:ima-testbed:arinc653-linux:1"
-    ET.register_namespace("ima", ns)
-    tree = ET.parse(ROOT / "config" / "nodes" / "rpas_node.xml")
-    root = tree.getroot()
-    last_part = [i for i, el in enumerate(root) if el.tag == "Partition"][-1]
-    part = ET.Element("Partition", PartitionIdentifier="3", PartitionName="mission_feed",
-                      Criticality="LEVEL_C", SystemPartition="false", EntryPoint="main")
-    ET.SubElement(part, "Sampling_Port", Name="MISSION_OUT", MaxMessageSize="56",
-                  Direction="SOURCE", RefreshRateSeconds="0.5")
-    ET.SubElement(part, "Process", Name="feed", StackSize="65536")
-    ET.SubElement(part, f"{{{ns}}}Linux", Executable="mission_feed", Arguments=feed_args)
-    root.insert(last_part + 1, part)
-    mem_at = [i for i, el in enumerate(root) if el.tag == "Partition_Memory"][-1]
-    mem = ET.Element("Partition_Memory", PartitionIdentifier="3", PartitionName="mission_feed")
-    ET.SubElement(mem, "Memory_Requirements", Type="DATA", SizeBytes="0x2000000",
-                  Access="READ_WRITE")
-    root.insert(mem_at + 1, mem)
-    sched = root.find("Module_Schedule")
-    ps = ET.SubElement(sched, "Partition_Schedule", PartitionIdentifier="3",
-                       PartitionName="mission_feed", PeriodSeconds="0.05",
-                       PeriodDurationSeconds="0.005")
-    ET.SubElement(ps, "Window_Schedule", WindowIdentifier="4", WindowStartSeconds="0.03",
-                  WindowDurationSeconds="0.005", PartitionPeriodStart="true")
-    table = root.find("Connection_Table")
-    ch = ET.SubElement(table, "Channel", ChannelIdentifier="9", ChannelName="mission")
-    src = ET.SubElement(ch, "Source")
-    ET.SubElement(src, "Standard_Partition", PartitionIdentifier="3",
-                  PartitionName="mission_feed", PortName="MISSION_OUT")
-    dst = ET.SubElement(ch, "Destination")
-    ET.SubElement(dst, "Standard_Partition", PartitionIdentifier="2", PartitionName="nav_fcs",
-                  PortName="MISSION_IN")
-    tree.write(dest, encoding="UTF-8", xml_declaration=True)
-    return dest
+    def add_feed(app: dict) -> None:
+        app["partitions"].append({
+            "name": "mission_feed", "criticality": "LEVEL_C", "personality": "apex-c",
+            "executable": "mission_feed", "arguments": list(feed_args), "period_s": 0.05,
+            "processes": [{"name": "feed", "period_s": 0.05, "stack": 65536, "priority": 10}],
+            "ports": [{"name": "MISSION_OUT", "direction": "source", "kind": "sampling",
+                       "size": 56, "refresh_s": 0.5, "message": "rpas_mission_msg_t"}],
+            "memory": [{"type": "DATA", "size": 0x2000000, "access": "READ_WRITE"}]})
+        app["schedule"]["windows"].append(
+            {"partition": "mission_feed", "start_s": 0.03, "duration_s": 0.005})
+        app["channels"]["intra_node"].append(
+            {"name": "mission", "from": "mission_feed.MISSION_OUT", "to": "nav_fcs.MISSION_IN"})
+    return scratch_system(dest, add_feed)
 
 
 def dump(f) -> str:

@@ -6,7 +6,7 @@ AUTOPILOT. Judged from the truth trace and from the FCS status frames on the bus
 from __future__ import annotations
 
 import pytest
-from flight_helpers import PILOTS, mission_node_module
+from flight_helpers import PILOTS, mission_system
 
 
 def _at(rows, t_s):
@@ -33,10 +33,9 @@ def c2_loss(flights):
 
 @pytest.fixture(scope="module")
 def mission(flights, tmp_path_factory):
-    module = mission_node_module(tmp_path_factory.mktemp("mission") / "node.xml",
-                                 "120 3300 95 40")
+    system = mission_system(tmp_path_factory.mktemp("mission"), ["120", "3300", "95", "40"])
     return flights.fly("mission", duration_s=90, seed=3, turbulence="none",
-                       pilot=PILOTS / "mission.yaml", node_module=module)
+                       pilot=PILOTS / "mission.yaml", system=system)
 
 
 def test_direct_surfaces_follow_the_stick(direct):

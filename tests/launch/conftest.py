@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from ima.flight import run as flight
+from ima.launch import options as launch_options
 from ima.flight.summary import read_jsonl
 from ima.launch import run as launch_run
 from ima.launch import summary as launch_summary
@@ -29,7 +29,7 @@ from launch_helpers import TRIPLEX  # noqa: E402
 class Run:
     run_dir: Path
     summary: dict
-    result: launch_run.LaunchRun
+    result: launch_options.LaunchRun
 
     def truth_between(self, t0_s: float, t1_s: float) -> list[dict]:
         return [r for r in read_jsonl(self.run_dir / "truth.jsonl") if t0_s <= r["t_ns"] / 1e9 < t1_s]
@@ -46,10 +46,10 @@ class LaunchCache:
     def launch(self, name: str, system: Path = TRIPLEX, on_status=None, **kw) -> Run:
         if name not in self.runs:
             run_dir = self.base / name
-            opts = launch_run.LaunchOptions(system=system, run_dir=run_dir, **kw)
+            opts = launch_options.LaunchOptions(system=system, run_dir=run_dir, **kw)
             result = fly_unless_host_stalled(
                 lambda: launch_run.launch(opts, on_status=on_status), run_dir, name)
-            pilot = Path(opts.pilot) if opts.pilot else flight.default_pilot()
+            pilot = Path(opts.pilot) if opts.pilot else launch_options.default_pilot()
             summary = launch_summary.summarise(run_dir, pilot, opts.duration_s, result.nodes,
                                                result.killed, result.wall_s, hung=result.hung)
             self.runs[name] = Run(run_dir, summary, result)

@@ -180,11 +180,11 @@ def test_two_of_three_killed_flies_on_one(kill_two):
 
 def test_flight_plot_marks_the_events_of_a_run_with_hm_events(wrong_output):
     """The plot takes the run's events (here node3 voted out), not its HM events."""
-    from ima.flight import run as flight
+    from ima.launch.options import default_pilot
     from ima.launch import summary as launch_summary
 
     assert wrong_output.summary["hm_events"] > 0
-    s = launch_summary.summarise(wrong_output.run_dir, flight.default_pilot(), 300.0,
+    s = launch_summary.summarise(wrong_output.run_dir, default_pilot(), 300.0,
                                  wrong_output.result.nodes, {}, plot=True)
     assert s["plot"].endswith("flight.png") and (wrong_output.run_dir / "flight.png").stat().st_size
     assert s["hm_events"] == wrong_output.summary["hm_events"]

@@ -16,7 +16,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from fakebus import FakeBus, LoopbackBus  # noqa: E402
 
-from conftest_helpers import ACT_CMDS, NS, PILOTS, act_cmd_injector  # noqa: E402
+from conftest_helpers import ACT_CMDS, NS, PILOTS, act_cmd_injector, model_voting  # noqa: E402
 
 @dataclass
 class LocalRun:
@@ -51,6 +51,8 @@ def local_world(tmp_path):
             script = pilot.load(PILOTS / script) if isinstance(script, str) else \
                 pilot.parse(script)
         bus = LoopbackBus(round(seconds * NS))
+        if opts.get("channels") is not None and "voting" not in opts:
+            opts["voting"] = model_voting()
         w = World(bus, script, run_dir, Options(seed=seed, **opts))
         trim = (w.trim["elev"], w.trim["ail"], w.trim["rud"], w.trim["thr"])
         injectors = []

@@ -14,6 +14,18 @@ ACT_A = MESSAGES["ACT_CMD_A"]
 ACT_CMDS = tuple(MESSAGES[f"ACT_CMD_{c}"] for c in "ABC")  # redundancy channels A, B, C
 
 
+def model_voting():
+    """The voting of the shipped triplex model (the world has none of its own)."""
+    from imaworld.config import VotingParams
+
+    from ima.deploy import load_system
+
+    system = load_system(ROOT / "config" / "systems" / "rpas_triplex.yaml")
+    v = system.voting
+    return VotingParams(tuple(v["thresholds"][a] for a in ("elev", "ail", "rud", "thr")),
+                        v["persist"], v["offset_s"], system.major_frame_s)
+
+
 def act_cmd_injector(cmd_of_t, channel_msg=ACT_A, until_ns: int | None = None):
     """ACT_CMD frames at 20 Hz: cmd_of_t(t_ns) -> (elev, ail, rud, thr) or None for silence."""
     cnt = [0]

@@ -5,6 +5,7 @@ world writes about it (world.jsonl, world.json) and its command line."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import subprocess
 import sys
@@ -12,7 +13,7 @@ import sys
 import pytest
 
 from conftest_helpers import ACT_CMDS as ACT
-from conftest_helpers import NS, PILOTS, act_cmd_injector
+from conftest_helpers import NS, PILOTS, act_cmd_injector, model_voting
 
 from imaworld.actuators import HOLD_LAST, NORMAL, SAFE, Actuators, VotingSelector
 from imaworld.config import ActuatorParams
@@ -46,9 +47,16 @@ def drive(act: Actuators, t0_s: float, t1_s: float, cmds) -> Actuators:
     return act
 
 
+def selector_args(**kw) -> dict:
+    """VotingSelector's settings: the shipped model's voting, changed by kw."""
+    v = model_voting()
+    return {"thresholds": v.thresholds, "persist": v.persist, "offset_ns": round(v.offset_s * NS),
+            "period_ns": round(v.period_s * NS), **kw}
+
+
 def voting(n: int = 3, **kw) -> Actuators:
     p = ActuatorParams()
-    return Actuators(p, TRIM, VotingSelector(n, **kw))
+    return Actuators(p, TRIM, VotingSelector(n, **selector_args(**kw)))
 
 
 def states(act: Actuators) -> list[tuple[float, str, str | None]]:
@@ -72,7 +80,7 @@ def test_three_healthy_channels_vote_mid3_at_45_ms():
 
 
 def test_a_frame_counts_in_the_first_vote_at_or_after_its_end():
-    sel = VotingSelector(3)
+    sel = VotingSelector(3, **selector_args())
     sel.update(0, 45 * MS, CMD)  # ends exactly at the vote: in it
     sel.update(1, 45 * MS + 1, CMD)  # known before the vote, but ended after it: the next one
     sel.update(2, 44 * MS, CMD)
@@ -207,7 +215,7 @@ def test_frames_of_channels_beyond_n_are_ignored():
 
 def test_a_vote_offset_outside_the_frame_is_refused():
     with pytest.raises(ValueError):
-        VotingSelector(3, offset_ns=50 * MS)
+        VotingSelector(3, **selector_args(offset_ns=50 * MS))
 
 
 # --- the world ---------------------------------------------------------------------------------
@@ -260,7 +268,7 @@ def test_world_votes_and_a_failed_channel_changes_nothing_in_the_flight(local_wo
 
 def test_world_all_channels_dead_holds_then_goes_safe(local_world):
     r = fly3(local_world, 4, lambda ch, t, trim: trim if t < 1 * NS else None, channels=3,
-             vote_persist=2)
+             voting=dataclasses.replace(model_voting(), persist=2))
     act = [e for e in r.events() if e["src"] == "actuators"]
     assert [(e["kind"], e.get("status") or e.get("state") or e.get("channel"))
             for e in act] == [("vote", "MID3"), ("actuator_state", "NORMAL"),
@@ -301,7 +309,7 @@ def test_world_command_line_voting_options(world_process, tmp_path):
 
     p, run_dir, _ = world_process(PILOTS / "hold.yaml", 1.5, args=[
         "--channels", "3", "--vote-threshold", "0.1,0.2,0.3,0.05", "--vote-persist", "4",
-        "--vote-offset", "0.03"], injector=inj)
+        "--vote-offset", "0.03", "--vote-period", "0.05"], injector=inj)
     assert p.returncode == 0, p.stderr
     s = json.loads((run_dir / "world.json").read_text())
     v = s["vote"]
@@ -319,7 +327,11 @@ def test_world_command_line_voting_options(world_process, tmp_path):
     (["--channels", "3", "--vote-threshold", "0.1,0.1,nan,0.1"], "four numbers"),
     (["--channels", "3", "--vote-threshold", "0.1,-1,0.1,0.1"], "four numbers"),
     (["--channels", "3", "--vote-persist", "0"], "at least 1"),
-    (["--channels", "2", "--vote-offset", "0.05"], "within the 0.05 s major frame"),
+    (["--channels", "2", "--vote-offset", "0.05", "--vote-period", "0.05"],
+     "within the 0.05 s major frame"),
+    (["--channels", "2", "--vote-period", "0"], "positive number"),
+    (["--channels", "3", "--vote-threshold", "0.1,0.1,0.1,0.1"],
+     "the vote needs --vote-persist, --vote-offset, --vote-period too"),
     (["--vote-persist", "2"], "only with --channels"),
 ])
 def test_world_command_line_refuses_bad_voting_options(tmp_path, args, message):

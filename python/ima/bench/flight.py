@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
-"""`ima bench flight`: speed-up of a 10-minute single-node flight, CAN bus throughput with
-four clients, and the peak memory of the whole flight (every process of it, summed)."""
+"""`ima bench flight`: speed-up of a 10-minute single-node flight (`ima fly`: the simplex system
+launched), CAN bus throughput with four clients, and the peak memory of the whole flight
+(every process of it, summed)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,8 @@ from pathlib import Path
 
 from ima import paths
 from ima.errors import ImaError
-from ima.flight import run as flight
+from ima.launch import options as launch_options
+from ima.launch import run as launch_run
 
 TARGETS = {"speedup": 50.0, "canbus_frames_per_s": 100_000.0, "peak_rss_mb": 300.0}
 _PAGE = os.sysconf("SC_PAGE_SIZE")
@@ -88,27 +90,33 @@ def canbus_throughput() -> dict:
         raise ImaError(f"ima-canbus-bench printed no JSON: {out.stdout[:200]!r}") from exc
 
 
+def measure_flight(system: Path, duration_s: float, seed: int, console) -> dict:
+    """One run of `system` as `ima launch` runs it (deployment included): emulated time
+    flown, wall time, speed-up, and the peak memory of all its processes."""
+    with tempfile.TemporaryDirectory(prefix="ima-bench-") as tmp:
+        opts = launch_options.LaunchOptions(system=system, duration_s=duration_s, seed=seed,
+                                            run_dir=Path(tmp) / "run")
+        with console.status(f"flying {system.stem} {duration_s:g} s (seed {seed}, light "
+                            "turbulence)"):
+            with RssSampler() as rss:
+                t0 = time.monotonic()
+                result = launch_run.launch(opts)
+                wall = time.monotonic() - t0
+        failed = {k: v for k, v in result.returncodes.items() if v not in (0, None)}
+        if failed:
+            raise ImaError(f"benchmark run failed: {failed}")
+        truth = (result.run_dir / "truth.jsonl").read_text().splitlines()
+        flown = json.loads(truth[-1])["t_ns"] / 1e9 if truth else 0.0
+    return {"nodes": len(result.nodes), "flight_s": round(flown, 1), "wall_s": round(wall, 2),
+            "speedup": round(flown / wall, 1), "peak_rss_mb": round(rss.peak / 2**20, 1)}
+
+
 def run(json_out: bool, duration_s: float = 600.0, seed: int = 1) -> int:
     from rich.console import Console
 
     console = Console(stderr=True)
-    results: dict = {}
-    with tempfile.TemporaryDirectory(prefix="ima-bench-flight-") as tmp:
-        opts = flight.FlightOptions(duration_s=duration_s, seed=seed, run_dir=Path(tmp) / "run")
-        with console.status(f"flying {duration_s:g} s (seed {seed}, light turbulence)"):
-            with RssSampler() as rss:
-                t0 = time.monotonic()
-                result = flight.fly(opts)
-                wall = time.monotonic() - t0
-        failed = {k: v for k, v in result.returncodes.items() if v not in (0, None)}
-        if failed:
-            raise ImaError(f"benchmark flight failed: {failed}")
-        truth = (result.run_dir / "truth.jsonl").read_text().splitlines()
-        flown = json.loads(truth[-1])["t_ns"] / 1e9 if truth else 0.0
-        results["flight_s"] = round(flown, 1)
-        results["wall_s"] = round(wall, 2)
-        results["speedup"] = round(flown / wall, 1)
-        results["peak_rss_mb"] = round(rss.peak / 2**20, 1)
+    results = measure_flight(launch_options.system_path("rpas_simplex"), duration_s, seed,
+                             console)
     with console.status("CAN bus throughput, 4 clients"):
         bus = canbus_throughput()
     results["canbus_frames_per_s"] = bus.get("canbus_frames_per_s")

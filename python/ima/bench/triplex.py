@@ -15,14 +15,10 @@
 from __future__ import annotations
 
 import json
-import tempfile
-import time
 from pathlib import Path
 
 from ima import paths
-from ima.bench.flight import RssSampler
-from ima.errors import ImaError
-from ima.launch import run as launch_run
+from ima.bench.flight import measure_flight
 
 TARGETS = {"speedup": 20.0, "latency_ratio": 2.0, "peak_rss_mb": 600.0}
 
@@ -38,25 +34,7 @@ def run(json_out: bool, duration_s: float = 600.0, seed: int = 1,
     from ima.bench import dds as dds_bench
 
     console = Console(stderr=True)
-    results: dict = {}
-    with tempfile.TemporaryDirectory(prefix="ima-bench-triplex-") as tmp:
-        opts = launch_run.LaunchOptions(system=system or default_system(), duration_s=duration_s,
-                                        seed=seed, run_dir=Path(tmp) / "run")
-        with console.status(f"flying the triplex {duration_s:g} s (seed {seed})"):
-            with RssSampler() as rss:
-                t0 = time.monotonic()
-                result = launch_run.launch(opts)
-                wall = time.monotonic() - t0
-        failed = {k: v for k, v in result.returncodes.items() if v not in (0, None)}
-        if failed:
-            raise ImaError(f"benchmark run failed: {failed}")
-        truth = (result.run_dir / "truth.jsonl").read_text().splitlines()
-        flown = json.loads(truth[-1])["t_ns"] / 1e9 if truth else 0.0
-        results["nodes"] = len(result.nodes)
-        results["flight_s"] = round(flown, 1)
-        results["wall_s"] = round(wall, 2)
-        results["speedup"] = round(flown / wall, 1)
-        results["peak_rss_mb"] = round(rss.peak / 2**20, 1)
+    results = measure_flight(system or default_system(), duration_s, seed, console)
     with console.status("DDS latency: two agents in real time, then ddsperf") as status:
         lat = dds_bench.measure(progress=lambda text: status.update(f"DDS latency {text}"))
     results["dds_latency_us_median"] = lat.get("dds_latency_us_median")

@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 
 from ima.commands import launch
-from ima.paths import repo_root
+from ima.launch.options import system_path
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -20,10 +20,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "climb) in light turbulence and a 10 kt wind, and print the summary judged from the "
         "world's truth trace. Same options as `ima launch`, e.g. --kill-node node2@120.",
     )
-    launch.add_launch_arguments(parser)
+    launch.add_run_arguments(parser, kind="demo")
     return parser
 
 
 def run(args: argparse.Namespace) -> int:
-    args.system = repo_root() / "config" / "systems" / "rpas_triplex.yaml"
-    return launch.run(args)
+    opts = launch.options_from(args, system=system_path("rpas_triplex"), kind="demo")
+    return launch.launch_and_summarise(opts, args.json)

@@ -1,24 +1,47 @@
 # SPDX-License-Identifier: Apache-2.0
 """`ima launch SYSTEM.yaml`: deploys a system model and flies it: world, CAN bus, and every
-node's SKE (with its partitions) and DDS agent, in lockstep; voted flight control."""
+node's SKE (with its partitions) and DDS agent, in lockstep; voted flight control. `ima fly`
+and `ima demo` are launches of a shipped system through the same options and code."""
 
 from __future__ import annotations
 
 import argparse
+import json
+import sys
 from pathlib import Path
 
-from ima.commands import fly
 from ima.errors import ImaError
-from ima.flight import run as flight
+from ima.launch import options as launch_options
+from ima.launch import report as launch_report
 from ima.launch import run as launch_run
 from ima.launch import summary as launch_summary
+
+
+def positive_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: '{text}'") from None
+    if not v > 0 or v == float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a positive number, not '{text}'")
+    return v
+
+
+def wind_kt(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: '{text}'") from None
+    if not 0 <= v <= 60:
+        raise argparse.ArgumentTypeError(f"wind must be within 0..60 kt, not '{text}'")
+    return v
 
 
 def _node_at(option: str):
     """The argparse type of a NODE@SECONDS option."""
     def parse(text: str) -> tuple[str, float]:
         try:
-            return launch_run.parse_kill(text, option)
+            return launch_options.parse_node_at(text, option)
         except ImaError as exc:
             raise argparse.ArgumentTypeError(str(exc)) from None
     return parse
@@ -26,14 +49,31 @@ def _node_at(option: str):
 
 def _wrong(text: str) -> tuple[str, str, float, float]:
     try:
-        return launch_run.parse_wrong_output(text)
+        return launch_options.parse_wrong_output(text)
     except ImaError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
-def add_launch_arguments(parser: argparse.ArgumentParser) -> None:
-    fly.add_flight_arguments(parser)
-    parser.add_argument("--kill-node", type=_node_at("--kill-node"), action="append", default=[], metavar="NODE@SECONDS",
+def add_run_arguments(parser: argparse.ArgumentParser, kind: str = "launch") -> None:
+    """The options of every run (`ima launch`, `ima fly`, `ima demo`)."""
+    parser.add_argument("--duration", type=positive_float, default=600.0, metavar="SECONDS",
+                        help="emulated flight time (default 600)")
+    parser.add_argument("--seed", type=int, default=1, metavar="N",
+                        help="seed of sensor noise and turbulence (default 1)")
+    parser.add_argument("--pilot", type=Path, metavar="FILE",
+                        help="remote pilot script (default sim/pilots/default.yaml)")
+    parser.add_argument("--turbulence", choices=launch_options.TURBULENCE, default="light",
+                        help="MIL-F-8785C turbulence (default light)")
+    parser.add_argument("--wind", type=wind_kt, default=10.0, metavar="KT",
+                        help="mean wind speed, from 270° (default 10)")
+    parser.add_argument("--realtime", action="store_true",
+                        help="follow the wall clock instead of running as fast as possible")
+    parser.add_argument("--run-dir", type=Path, metavar="DIR",
+                        help=f"where the traces go (default runs/{kind}-<date>-<time>-seed<N>)")
+    parser.add_argument("--json", action="store_true",
+                        help="print the summary as one JSON object on stdout")
+    parser.add_argument("--kill-node", type=_node_at("--kill-node"), action="append", default=[],
+                        metavar="NODE@SECONDS",
                         help="stop a whole processor at that emulated time (repeatable), "
                         "e.g. node2@120")
     parser.add_argument("--hang-node", type=_node_at("--hang-node"), action="append", default=[],
@@ -56,24 +96,24 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="deploy a system model and fly it on its emulated processors (voted flight control)",
         description="Deploy SYSTEM.yaml (config/systems/) and fly it: the CAN bus, the world "
         "(JSBSim, smart actuators voting over the replicas), and on every node an SKE with the "
-        "partition set and a DDS agent, all in lockstep emulated time (or --realtime). A live "
-        "view shows each node and the vote; the summary ends the run.",
+        "partition set and, with several nodes, a DDS agent, all in lockstep emulated time (or "
+        "--realtime). A live view shows each node and the vote; the summary ends the run.",
     )
     parser.add_argument("system", type=Path, metavar="SYSTEM.yaml", help="the system model")
-    add_launch_arguments(parser)
+    add_run_arguments(parser)
     return parser
 
 
-def options_from(args: argparse.Namespace) -> launch_run.LaunchOptions:
-    return launch_run.LaunchOptions(
-        system=args.system, duration_s=args.duration, seed=args.seed, pilot=args.pilot,
+def options_from(args: argparse.Namespace, system: Path | None = None,
+                 kind: str = "launch") -> launch_options.LaunchOptions:
+    return launch_options.LaunchOptions(
+        system=system or args.system, duration_s=args.duration, seed=args.seed, pilot=args.pilot,
         turbulence=args.turbulence, wind_kt=args.wind, realtime=args.realtime,
-        run_dir=args.run_dir, kill=list(args.kill_node), hang=list(args.hang_node),
-        wrong_output=list(args.test_wrong_output),
-        netns=args.netns)
+        run_dir=args.run_dir, kind=kind, kill=list(args.kill_node), hang=list(args.hang_node),
+        wrong_output=list(args.test_wrong_output), netns=args.netns)
 
 
-def launch_and_summarise(opts: launch_run.LaunchOptions, json_out: bool) -> int:
+def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> int:
     from rich.console import Console, Group
     from rich.live import Live
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
@@ -84,29 +124,21 @@ def launch_and_summarise(opts: launch_run.LaunchOptions, json_out: bool) -> int:
     console = Console(stderr=json_out)
     system = load_system(Path(opts.system))
     nodes = [n.name for n in system.nodes]
-    pilot = Path(opts.pilot) if opts.pilot else flight.default_pilot()
+    pilot = Path(opts.pilot) if opts.pilot else launch_options.default_pilot()
     progress = Progress(TextColumn("[bold]flight[/]"), BarColumn(),
                         TextColumn("{task.completed:>6.0f}/{task.total:.0f} s"),
                         TimeRemainingColumn(), console=console)
     task = progress.add_task("flight", total=opts.duration_s)
-    holder: dict = {}
+    if opts.run_dir is None:
+        opts.run_dir = launch_options.new_run_dir(opts.kind, opts.seed)
+    state = LiveState(Path(opts.run_dir), nodes, dict(opts.kill), hangs=dict(opts.hang))
 
     with Live(progress, console=console, transient=True, refresh_per_second=4) as live:
         def on_status(st: dict) -> None:
-            state = holder.get("state")
-            if state is None:
-                run_dir = holder.get("run_dir")
-                if run_dir is None:
-                    return
-                state = holder["state"] = LiveState(run_dir, nodes, dict(opts.kill),
-                                                    hangs=dict(opts.hang))
             state.update(st)
             progress.update(task, completed=min(st.get("t_s", 0), opts.duration_s))
             live.update(Group(state.render(), progress))
 
-        if opts.run_dir is None:
-            opts.run_dir = flight.new_run_dir("launch", opts.seed)
-        holder["run_dir"] = Path(opts.run_dir)
         result = launch_run.launch(opts, on_status=on_status)
     summary = launch_summary.summarise(result.run_dir, pilot, opts.duration_s, result.nodes,
                                        result.killed, result.wall_s, plot=True,
@@ -115,23 +147,16 @@ def launch_and_summarise(opts: launch_run.LaunchOptions, json_out: bool) -> int:
     summary["dds_domain"] = result.domain
     failed = {k: v for k, v in result.returncodes.items()
               if v not in (0, None) and k.split("/")[0] not in {**result.killed, **result.hung}}
-    return fly.report(summary, failed, result.run_dir, result.interrupted, json_out, console,
-                      print_summary)
-
-
-def print_summary(s: dict, console) -> None:
-    fly.print_summary(s, console)
-    killed = ", ".join([f"{k['node']}@{k['t_s']:g}s (killed)" for k in s["killed"]]
-                       + [f"{k['node']}@{k['t_s']:g}s (hung)" for k in s.get("hung", [])]) or "none"
-    console.print(f"Nodes: {', '.join(s['nodes'])}; stopped on purpose: {killed}")
-    vo = ", ".join(f"{v['node']}@{v['t_s']:.3f}s ({v['reason']})" for v in s["voted_out"]) or "none"
-    console.print(f"Voted out by the actuators: {vo}; final vote {s.get('vote_status') or '-'}")
-    agreed = "agreed" if s.get("membership_agreed") else "[red]NOT agreed[/]"
-    console.print(f"Membership ({agreed}): {', '.join(s.get('membership') or []) or '-'}")
-    for ev in s.get("membership_events", [])[:6]:
-        console.print(f"  {ev['t_s']:9.3f} s {ev['node']}: {','.join(ev['members'])}")
-    for ev in s.get("monitor_reports", [])[:6]:
-        console.print(f"  {ev['t_s']:9.3f} s {ev['node']} monitor: {ev['text']}", markup=False)
+    if json_out:
+        json.dump(summary, sys.stdout)
+        sys.stdout.write("\n")
+    else:
+        launch_report.print_summary(summary, console)
+    if result.interrupted:
+        raise KeyboardInterrupt
+    if failed:
+        raise ImaError(f"processes failed: {failed} (logs in {result.run_dir})")
+    return 0
 
 
 def run(args: argparse.Namespace) -> int:

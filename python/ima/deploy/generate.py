@@ -28,9 +28,14 @@ class DeployResult:
 
 
 def _write(path: Path, text: str) -> int:
+    """Writes `text` unless the file already holds it (an unchanged header keeps its time, so
+    the build does not recompile what includes it)."""
+    data = text.encode("utf-8")
     try:
+        if path.is_file() and path.read_bytes() == data:
+            return text.count("\n")
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text, encoding="utf-8", newline="\n")
+        path.write_bytes(data)
     except OSError as exc:
         raise ImaError(f"{path}: cannot write: {exc.strerror or exc}") from exc
     return text.count("\n")
@@ -53,9 +58,12 @@ def _remove_stale(out_dir: Path, keep: set[Path]) -> None:
             path.unlink()
 
 
-def generate(system: System, out_dir: Path | str) -> DeployResult:
+def generate(system: System, out_dir: Path | str,
+             extra_arguments: dict[tuple[str, str], list[str]] | None = None) -> DeployResult:
     """Writes out_dir/<node>.xml per node (each validated against the module XSD) and
-    out_dir/glue/*.h; raises ImaError (file, line, rule) if a module does not validate."""
+    out_dir/glue/*.h; raises ImaError (file, line, rule) if a module does not validate.
+    `extra_arguments` (node, partition) -> words: a run's additions to a partition's arguments
+    on one node (a test switch), after the model's."""
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise ImaError(f"{out_dir}: not a directory", exit_code=2)
@@ -63,20 +71,30 @@ def generate(system: System, out_dir: Path | str) -> DeployResult:
 
     for node in system.nodes:
         path = out_dir / f"{node.name}.xml"
-        result.files.append((path, _write(path, module_xml.render(system, node))))
+        extra = {part: words for (n, part), words in (extra_arguments or {}).items()
+                 if n == node.name}
+        result.files.append((path, _write(path, module_xml.render(system, node, extra))))
         xsd.validate_module(path)
         result.modules[node.name] = path
-    for p in system.partitions:
-        path = out_dir / GLUE_DIR / glue.port_header_name(p)
-        result.files.append((path, _write(path, glue.render_partition(system, p))))
+    for path, lines in write_glue(system, out_dir / GLUE_DIR):
+        result.files.append((path, lines))
         result.glue.append(path)
-    path = out_dir / GLUE_DIR / glue.system_header_name(system)
-    result.files.append((path, _write(path, glue.render_system(system))))
-    result.glue.append(path)
 
     _remove_stale(out_dir, {f for f, _ in result.files})
     result.summary = summarise(system, result)
     return result
+
+
+def write_glue(system: System, glue_dir: Path) -> list[tuple[Path, int]]:
+    """Writes the C glue alone into glue_dir: one header per partition, then the system's.
+    Returns (file, lines) of each. The build generates the partitions' contract this way."""
+    out = []
+    for p in system.partitions:
+        path = glue_dir / glue.port_header_name(p)
+        out.append((path, _write(path, glue.render_partition(system, p))))
+    path = glue_dir / glue.system_header_name(system)
+    out.append((path, _write(path, glue.render_system(system))))
+    return out
 
 
 def summarise(system: System, result: DeployResult) -> dict:

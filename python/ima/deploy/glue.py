@@ -1,12 +1,13 @@
 # SPDX-License-Identifier: Apache-2.0
 """Writes the C glue of a system: one header per partition (its ports, processes and channels
-as the module configures them) and one for the system (nodes, frame, voting, membership)."""
+as the module configures them, the check of its message types) and one for the system (nodes,
+frame, buses, the types of the partitions' tables)."""
 
 from __future__ import annotations
 
 import re
 
-from ima.deploy.model import VOTING_AXES, Partition, System, seconds_text
+from ima.deploy.model import Partition, System, seconds_text
 
 
 def port_header_name(partition: Partition) -> str:
@@ -62,10 +63,13 @@ def render_partition(system: System, p: Partition) -> str:
     lines = _prologue(
         system,
         f"Partition {p.name} of system {system.name}: its identifier, processes and ports as "
-        "its module\n * configures them. The *_DIRECTION and *_DEADLINE values are APEX "
-        "constants: include\n * ARINC653.h before using them.",
+        "its module\n * configures them, as macros and as tables to create them from, and the "
+        "check that each port's\n * message type has the port's size.",
         guard)
-    lines += [f'#include "{system_header_name(system)}"', ""]
+    lines += [f'#include "{system_header_name(system)}"']
+    if system.messages_header and any(po.message for po in p.ports):
+        lines += [f'#include "{system.messages_header}"']
+    lines += ["", "#ifdef __cplusplus", 'extern "C" {', "#endif", ""]
     replicated = p.name in system.replicated
     lines += _defines([
         (f"{P}_PARTITION_ID", str(p.ident), "PartitionIdentifier"),
@@ -119,7 +123,14 @@ def render_partition(system: System, p: Partition) -> str:
             rows.append((f"{X}_MAX_NB_MESSAGES", str(po.max_messages), None))
         rows += [(f"{X}_CHANNEL_ID", str(ch.ident if ch else 0), None),
                  (f"{X}_CHANNEL_NAME", _str(ch.name if ch else ""), None)]
+        if po.message:
+            rows.append((f"{X}_MESSAGE", po.message, "its messages' C type"))
         lines += ["", f"/* {po.name}: {po.kind} {po.direction}, {where} */"] + _defines(rows)
+        if po.message:
+            lines += [f"{app}_GLUE_CHECK(sizeof({po.message}) == {X}_SIZE,",
+                      f'    "{p.name}.{po.name}: sizeof({po.message}) differs from the port '
+                      f'size in the model ({po.size})");']
+    lines += _spec_tables(system, p)
 
     traffic = {n: t[p.name] for n, t in system.can_traffic.items() if p.name in t}
     topics = [t["name"] for t in system.dds_topics if t["partition"] == p.name]
@@ -131,19 +142,46 @@ def render_partition(system: System, p: Partition) -> str:
         if topics:
             lines.append(f" *   DDS topics, through the node's agent: {', '.join(topics)}")
         lines.append(" */")
-    lines += ["", f"#endif /* {guard} */"]
+    lines += ["", "#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */"]
     return "\n".join(_wrap_comments(lines)) + "\n"
 
 
+def _spec_tables(system: System, p: Partition) -> list[str]:
+    """<partition>_process_spec[] and <partition>_port_spec[], in the order of their enums."""
+    a, P = system.application, _macro(p.name)
+    lines = ["", "/* The processes and ports in the order of their enums, for a partition that "
+             "creates them\n * in a loop: {name, period, offset, stack, priority, deadline} and "
+             "{name, kind,\n * direction, size, refresh period, queue capacity, channel}. */",
+             f"static const {a}_process_spec_t {p.name}_process_spec[{P}_PROCESS_COUNT] = {{"]
+    for pr in p.processes:
+        lines.append(f"    [{P}_PROCESS_{_macro(pr.name)}] = {{{_str(pr.name)}, "
+                     f"{_ns(pr.period_ns)}, {_ns(pr.offset_ns)}, {pr.stack}, {pr.priority}, "
+                     f"{pr.deadline.upper()}}},")
+    lines.append("};")
+    if not p.ports:
+        return lines
+    lines.append(f"static const {a}_port_spec_t {p.name}_port_spec[{P}_PORT_COUNT] = {{")
+    for po in p.ports:
+        ch = system.channel_of(p.name, po.name)
+        lines.append(f"    [{P}_PORT_{_macro(po.name)}] = {{{_str(po.name)}, "
+                     f"{_macro(a)}_PORT_{po.kind.upper()}, {po.direction.upper()}, {po.size}, "
+                     f"{_ns(po.refresh_ns or 0)}, {po.max_messages or 0}, "
+                     f"{ch.ident if ch else 0}}},")
+    lines.append("};")
+    return lines
+
+
 def render_system(system: System) -> str:
-    """`<application>_system.h`: the nodes, the major frame, voting, membership, buses."""
+    """`<application>_system.h`: the nodes, the major frame, the buses, the spec types."""
     app = _macro(system.application)
     guard = f"{app}_SYSTEM_H"
     lines = _prologue(
         system,
         f"System {system.name}: its nodes and their ARINC 825 redundancy channels (RCI: A = 0,\n"
-        " * B = 1, C = 2), the major frame, the voting and membership parameters, the buses.",
+        " * B = 1, C = 2), the major frame, the buses, and the types of the partitions' tables.\n"
+        " * Voting and membership settings reach the partitions at run time, as arguments.",
         guard)
+    lines += ['#include "ARINC653.h"', ""]
     n = len(system.nodes)
     lines += _defines([
         (f"{app}_SYSTEM_NAME", _str(system.name), None),
@@ -171,25 +209,38 @@ def render_system(system: System) -> str:
     lines += _defines([(f"{app}_PARTITION_{_macro(p.name)}_ID", str(p.ident),
                         "replicated" if p.name in system.replicated else None)
                        for p in system.partitions])
-    lines += ["", "enum " + system.application + "_port_kind {",
-              f"    {app}_PORT_SAMPLING = 0,", f"    {app}_PORT_QUEUING = 1", "};"]
-    v = system.voting
-    lines += ["", "/* Voting of the replicas' commands: per-axis thresholds (normalised), "
-              "consecutive\n * frames before a replica is voted out, the vote's offset in the "
-              "major frame. */"]
-    lines += _defines(
-        [(f"{app}_VOTE_REPLICAS", str(n if system.replicated else 0), None)]
-        + [(f"{app}_VOTE_THRESHOLD_{a.upper()}", repr(float(v["thresholds"][a])), None)
-           for a in VOTING_AXES]
-        + [(f"{app}_VOTE_PERSIST", str(v["persist"]), None),
-           (f"{app}_VOTE_OFFSET_NS", _ns(round(v["offset_s"] * 1e9)), None)])
-    m = system.membership
-    lines += ["", "/* Membership: a node is lost after this many major frames without its "
-              "heartbeat\n * (the CAN message <HEARTBEAT>_<channel letter>). */"]
-    lines += _defines([
-        (f"{app}_HEARTBEAT_MESSAGE", _str(m["heartbeat"]), None),
-        (f"{app}_HEARTBEAT_MISSED_FRAMES", str(m["missed_frames"]), None),
-    ])
+    a = system.application
+    lines += ["", "enum " + a + "_port_kind {",
+              f"    {app}_PORT_SAMPLING = 0,", f"    {app}_PORT_QUEUING = 1", "};",
+              "",
+              "/* A process as the model declares it (<partition>_process_spec[] in its",
+              " * header). */",
+              "typedef struct {",
+              "    const char *name;",
+              "    SYSTEM_TIME_TYPE period_ns;",
+              "    SYSTEM_TIME_TYPE offset_ns; /* DELAYED_START delay; 0: START */",
+              "    STACK_SIZE_TYPE stack_size;",
+              "    PRIORITY_TYPE priority;",
+              "    DEADLINE_TYPE deadline;",
+              f"}} {a}_process_spec_t;",
+              "",
+              "/* A port as the model declares it (<partition>_port_spec[] in its header). */",
+              "typedef struct {",
+              "    const char *name;",
+              f"    enum {a}_port_kind kind;",
+              "    PORT_DIRECTION_TYPE direction;",
+              "    MESSAGE_SIZE_TYPE size;",
+              "    SYSTEM_TIME_TYPE refresh_ns; /* sampling ports */",
+              "    MESSAGE_RANGE_TYPE max_nb_messages; /* queuing ports */",
+              "    int channel_id; /* the channel it is an end of; 0: none */",
+              f"}} {a}_port_spec_t;",
+              "",
+              "/* A compile-time check in C and in C++. */",
+              "#ifdef __cplusplus",
+              f"#define {app}_GLUE_CHECK static_assert",
+              "#else",
+              f"#define {app}_GLUE_CHECK _Static_assert",
+              "#endif"]
     d = system.dds
     lines += ["", "/* Buses: the CAN bit rate; the DDS QoS and topics between the nodes. */"]
     lines += _defines(

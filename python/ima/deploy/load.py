@@ -13,11 +13,11 @@ from pathlib import Path
 from typing import Any
 
 import jsonschema
-import yaml
 
 from ima import paths
-from ima.deploy.locate import Locator, path_text
+from ima.deploy.locate import path_text
 from ima.deploy.model import (
+    ARGUMENT_FIELDS,
     HM_ERRORS,
     HM_STATES,
     NS_PER_S,
@@ -33,8 +33,10 @@ from ima.deploy.model import (
     System,
     SystemModelError,
     Window,
+    argument_fields,
     seconds_text,
 )
+from ima.deploy.source import Source, read_source
 
 MAX_ERRORS_SHOWN = 5
 QUEUE_BYTES_MAX = 64 * 1024 * 1024  # the SKE's limit on one queuing port
@@ -70,58 +72,30 @@ def display_name(path: Path) -> str:
 
 
 class _Reporter:
-    """Builds the one-line errors: `FILE:LINE: PATH: MESSAGE`."""
+    """Builds the one-line errors: `FILE:LINE: PATH: MESSAGE` (the file that holds the value)."""
 
-    def __init__(self, file: str, locator: Locator) -> None:
-        self.file = file
-        self.locator = locator
+    def __init__(self, source: Source) -> None:
+        self.source = source
 
     def where(self, parts: tuple) -> str:
-        line = self.locator.line(parts)
-        return f"{self.file}:{line}" if line else self.file
+        return self.source.where(parts)
+
+    def line(self, parts: tuple) -> int:
+        return self.source.file_of(parts).locator.line(parts) or 0
 
     def fail(self, parts: tuple, message: str) -> SystemModelError:
         return SystemModelError(f"{self.where(parts)}: {path_text(parts)}: {message}")
 
 
 def load_system(path: Path | str) -> System:
-    """Loads and checks a system model; raises ImaError (SystemModelError) naming what is wrong."""
+    """Loads and checks a system model (and the file it includes); raises ImaError
+    (SystemModelError) naming what is wrong."""
     path = Path(path)
-    if not path.is_file():
-        raise SystemModelError(f"{path}: no such system file")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SystemModelError(f"{path}: cannot read: {exc}") from exc
-    try:
-        root_node = yaml.compose(text, Loader=yaml.SafeLoader)
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"{path}:{mark.line + 1}" if mark else str(path)
-        problem = getattr(exc, "problem", None) or str(exc)
-        raise SystemModelError(f"{where}: not valid YAML: {problem}") from exc
-    _check_unique_keys(root_node, path)
-    rep = _Reporter(str(path), Locator(root_node))
-    _validate_schema(doc, rep)
-    _check_finite(doc, (), rep)
-    return _Builder(doc, path, rep).build()
-
-
-def _check_unique_keys(node: yaml.Node | None, path: Path, parts: tuple = ()) -> None:
-    """YAML keeps the last of two equal keys without a word: refuse them instead."""
-    if isinstance(node, yaml.MappingNode):
-        seen: set[str] = set()
-        for key, value in node.value:
-            name = key.value if isinstance(key, yaml.ScalarNode) else str(key)
-            if name in seen:
-                raise SystemModelError(f"{path}:{key.start_mark.line + 1}: {path_text(parts)}: "
-                                       f"key '{name}' appears twice")
-            seen.add(name)
-            _check_unique_keys(value, path, parts + (name,))
-    elif isinstance(node, yaml.SequenceNode):
-        for i, item in enumerate(node.value):
-            _check_unique_keys(item, path, parts + (i,))
+    source = read_source(path)
+    rep = _Reporter(source)
+    _validate_schema(source.doc, rep)
+    _check_finite(source.doc, (), rep)
+    return _Builder(source.doc, path, rep).build()
 
 
 def _validate_schema(doc: Any, rep: _Reporter) -> None:
@@ -130,7 +104,7 @@ def _validate_schema(doc: Any, rep: _Reporter) -> None:
     # the most relevant error of its alternatives, which names the value at fault.
     found = [jsonschema.exceptions.best_match([e]) for e in validator.iter_errors(doc)]
     errors = sorted(found,
-                    key=lambda e: (rep.locator.line(tuple(e.absolute_path)) or 0,
+                    key=lambda e: (rep.line(tuple(e.absolute_path)),
                                    list(map(str, e.absolute_path)), e.message))
     if not errors:
         return
@@ -139,7 +113,7 @@ def _validate_schema(doc: Any, rep: _Reporter) -> None:
     text = f"{rep.where(parts)}: {path_text(parts)}: {_message(first)}"
     for e in errors[1:MAX_ERRORS_SHOWN]:
         p = tuple(e.absolute_path)
-        text += f"; line {rep.locator.line(p)}: {path_text(p)}: {_message(e)}"
+        text += f"; {rep.where(p)}: {path_text(p)}: {_message(e)}"
     if len(errors) > MAX_ERRORS_SHOWN:
         text += f" (and {len(errors) - MAX_ERRORS_SHOWN} more)"
     raise SystemModelError(text)
@@ -182,7 +156,7 @@ class _Builder:
         self.doc = doc
         self.path = path
         self.rep = rep
-        self.base = path.resolve().parent
+        self.source = rep.source
 
     def fail(self, parts: tuple, message: str) -> SystemModelError:
         return self.rep.fail(parts, message)
@@ -194,9 +168,10 @@ class _Builder:
                                    "(at most 9 decimals)")
         return int(ns)
 
-    def file(self, value: str) -> Path:
+    def file(self, top_key: str, value: str) -> Path:
+        """A path written under `top_key`, relative to the folder of the file that wrote it."""
         p = Path(os.path.expanduser(value))
-        return p if p.is_absolute() else (self.base / p).resolve()
+        return p if p.is_absolute() else (self.source.base(top_key) / p).resolve()
 
     # -- the parts, in the order of the file ---------------------------------------------
 
@@ -214,6 +189,7 @@ class _Builder:
         dds, topics = self.dds(partitions)
         voting = self.voting(major_frame_ns)
         membership = self.membership(nodes, can)
+        header = self.messages_header(partitions)
         return System(
             name=d["system"], path=self.path.resolve(), source=display_name(self.path),
             application=d["application"],
@@ -223,7 +199,19 @@ class _Builder:
             major_frame_ns=major_frame_ns, windows=windows, hm_system=hm_system,
             hm_module=hm_module, channels=channels, can=can, dds=dds, dds_topics=topics,
             voting=voting, membership=membership, can_traffic=traffic,
+            messages_header=header, included=self.source.included(),
         )
+
+    def messages_header(self, partitions: list[Partition]) -> str | None:
+        header = self.doc.get("messages_header")
+        if header is None:
+            for i, p in enumerate(partitions):
+                for k, po in enumerate(p.ports):
+                    if po.message:
+                        raise self.fail(("partitions", i, "ports", k, "message"),
+                                        f"{p.name}.{po.name} names its message type "
+                                        f"{po.message}, but no messages_header declares it")
+        return header
 
     def nodes(self) -> list[Node]:
         out: list[Node] = []
@@ -265,7 +253,7 @@ class _Builder:
                 ident=i + 1, name=p["name"], criticality=p["criticality"],
                 system_partition=bool(p.get("system_partition", False)),
                 personality=p["personality"], executable=p["executable"],
-                arguments=list(p.get("arguments") or []), period_ns=period_ns,
+                arguments=self.arguments(at, p.get("arguments") or []), period_ns=period_ns,
                 processes=self.processes(at, p["processes"], period_ns),
                 ports=self.ports(at, p["ports"]),
                 memory=[Memory(m["size"], m.get("type"), m.get("access"))
@@ -273,6 +261,21 @@ class _Builder:
                 hm=self.hm_table(p.get("health_monitoring") or {}),
             ))
         return out
+
+    def arguments(self, at: tuple, words: list[str]) -> list[str]:
+        """Arguments whose {names} are all ARGUMENT_FIELDS (filled in per node on deploy)."""
+        for k, word in enumerate(words):
+            rest = word
+            for name in argument_fields(word):
+                if name not in ARGUMENT_FIELDS:
+                    raise self.fail(at + ("arguments", k),
+                                    f"'{{{name}}}' in '{word}' is not a field deploy fills in "
+                                    f"(fields: {', '.join(ARGUMENT_FIELDS)})")
+                rest = rest.replace(f"{{{name}}}", "")
+            if "{" in rest or "}" in rest:
+                raise self.fail(at + ("arguments", k),
+                                f"'{word}': a brace that does not enclose a field name")
+        return list(words)
 
     def c_name(self, at: tuple, name: str, taken: list[str], what: str) -> None:
         """A port or process name is unique in its partition, also once upper-cased (the C
@@ -320,7 +323,7 @@ class _Builder:
                                     "only a queuing port has a queue capacity")
                 refresh = self.seconds(here + ("refresh_s",), po["refresh_s"])
                 out.append(Port(po["name"], po["direction"], "sampling", po["size"],
-                                refresh_ns=refresh))
+                                refresh_ns=refresh, message=po.get("message")))
             else:
                 if "refresh_s" in po:
                     raise self.fail(here + ("refresh_s",),
@@ -330,7 +333,7 @@ class _Builder:
                                     f"{po['max_messages']} messages of {po['size']} bytes "
                                     "exceed the 64 MiB a queuing port may hold")
                 out.append(Port(po["name"], po["direction"], "queuing", po["size"],
-                                max_messages=po["max_messages"]))
+                                max_messages=po["max_messages"], message=po.get("message")))
         return out
 
     def replicated(self, partitions: list[Partition]) -> list[str]:
@@ -479,7 +482,7 @@ class _Builder:
             ) -> tuple[dict, dict[str, dict[str, CanTraffic]]]:
         at = ("channels", "can")
         spec = self.doc["channels"]["can"]
-        dbc = self.file(spec["dbc"])
+        dbc = self.file("channels", spec["dbc"])
         messages = self.dbc_messages(at + ("dbc",), dbc)
         self.can_messages = messages
         names = [p.name for p in partitions]
@@ -548,7 +551,7 @@ class _Builder:
                                 f"no partition named '{t['partition']}' (partitions: "
                                 f"{', '.join(names)})")
             topics.append({"name": t["name"], "partition": t["partition"]})
-        config = self.file(spec["config"])
+        config = self.file("channels", spec["config"])
         if not config.is_file():
             raise self.fail(at + ("config",), f"no such file: {config}")
         lease = self.seconds(at + ("liveliness_lease_s",), spec["liveliness_lease_s"])

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -35,6 +36,35 @@ HM_ERRORS = {
 }
 
 VOTING_AXES = ("elev", "ail", "rud", "thr")
+
+# What a partition's `arguments` may hold in braces, filled in per node by `ima deploy`:
+# the settings that differ from node to node or come from the model reach a partition this
+# way (its module's `ima:Linux Arguments`), so one program serves every node and every model.
+ARGUMENT_FIELDS = {
+    "node": "the node's name (node2)",
+    "node_index": "the node's index 1..3",
+    "node_channel": "its ARINC 825 redundancy channel letter A..C",
+    "node_indices": "the indices of the system's nodes, 1,2,3",
+    "canbus_socket": "the CAN bus socket, relative to the node's ima-ske working directory",
+    "dds_socket": "the node's DDS agent socket, relative to the same directory",
+    "vote_thresholds": "voting.thresholds as elev,ail,rud,thr",
+    "vote_persist": "voting.persist",
+    "membership_missed_frames": "membership.missed_frames",
+}
+_FIELD = re.compile(r"\{([^{}]*)\}")
+
+
+def argument_fields(word: str) -> list[str]:
+    """The {names} in an argument word."""
+    return _FIELD.findall(word)
+
+
+def canbus_socket_name() -> str:
+    return "can.sock"
+
+
+def dds_socket_name(index: int) -> str:
+    return f"dds{index}.sock"
 
 
 class SystemModelError(ImaError):
@@ -76,6 +106,7 @@ class Port:
     size: int
     refresh_ns: int | None = None  # sampling ports
     max_messages: int | None = None  # queuing ports
+    message: str | None = None  # the C type of its messages (checked against `size`)
 
     @property
     def is_source(self) -> bool:
@@ -185,6 +216,8 @@ class System:
     membership: dict  # {"heartbeat": str, "missed_frames": int}
     # node name -> partition name -> its CAN traffic on that node ({channel} expanded).
     can_traffic: dict[str, dict[str, CanTraffic]] = field(default_factory=dict)
+    messages_header: str | None = None  # the C header declaring the ports' message types
+    included: list[Path] = field(default_factory=list)  # the file(s) the model includes
 
     @property
     def major_frame_s(self) -> float:
@@ -195,6 +228,26 @@ class System:
 
     def node(self, name: str) -> Node | None:
         return next((n for n in self.nodes if n.name == name), None)
+
+    def argument_values(self, node: Node) -> dict[str, str]:
+        """What each ARGUMENT_FIELDS name stands for on `node`."""
+        v = self.voting
+        return {
+            "node": node.name,
+            "node_index": str(node.index),
+            "node_channel": node.channel,
+            "node_indices": ",".join(str(i) for i in sorted(n.index for n in self.nodes)),
+            "canbus_socket": canbus_socket_name(),
+            "dds_socket": dds_socket_name(node.index),
+            "vote_thresholds": ",".join(f"{float(v['thresholds'][a]):g}" for a in VOTING_AXES),
+            "vote_persist": str(v["persist"]),
+            "membership_missed_frames": str(self.membership["missed_frames"]),
+        }
+
+    def arguments(self, partition: Partition, node: Node) -> list[str]:
+        """The partition's arguments on `node`, every {name} filled in."""
+        values = self.argument_values(node)
+        return [_FIELD.sub(lambda m: values[m.group(1)], w) for w in partition.arguments]
 
     def channel_of(self, partition: str, port: str) -> Channel | None:
         """The channel a port is an end of, if any."""

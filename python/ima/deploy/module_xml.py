@@ -67,7 +67,7 @@ def _process_text(pr) -> str:
     return text + ")"
 
 
-def _partition(system: System, p: Partition) -> list[str]:
+def _partition(system: System, node: Node, p: Partition, extra: list[str]) -> list[str]:
     procs = ", ".join(_process_text(pr) for pr in p.processes)
     role = "replicated on every node" if p.name in system.replicated else "this node's own"
     lines = [_comment(f"{p.name}: {p.personality}, {p.rate_hz:g} Hz, {role}; processes {procs}.",
@@ -89,7 +89,8 @@ def _partition(system: System, p: Partition) -> list[str]:
                                               ("MaxNbMessages", port.max_messages)])
     for pr in p.processes:
         lines += _tag(4, "Process", [("Name", pr.name), ("StackSize", pr.stack)])
-    args = " ".join(p.arguments) if p.arguments else None
+    words = system.arguments(p, node) + extra
+    args = " ".join(words) if words else None
     lines += _tag(4, "ima:Linux", [("Executable", p.executable), ("Arguments", args)])
     lines.append("  </Partition>")
     return lines
@@ -155,8 +156,9 @@ def _connections(system: System) -> list[str]:
     return lines
 
 
-def render(system: System, node: Node) -> str:
-    """The module XML of `node`: the system's partition set, schedule, HM tables, channels."""
+def render(system: System, node: Node, extra: dict[str, list[str]] | None = None) -> str:
+    """The module XML of `node`: the system's partition set, schedule, HM tables, channels.
+    `extra`: partition -> arguments added after the model's (a run's test switches)."""
     parts = ", ".join(p.name for p in system.partitions)
     lines = [
         # Never wrapped: the first line says it all (and marks the file as ours).
@@ -180,7 +182,7 @@ def render(system: System, node: Node) -> str:
         lines += _hm_entries(system.hm_module, "Error_ID_Action", "Action", described=False)
         lines.append("  </Module_HM_Table>")
     for p in system.partitions:
-        lines += [""] + _partition(system, p)
+        lines += [""] + _partition(system, node, p, (extra or {}).get(p.name, []))
     memory = [p for p in system.partitions if p.memory]
     if memory:
         lines.append("")

@@ -5,7 +5,7 @@
 
 #include "fcs.h"
 #include "nf_math.h"
-#include "nf_test.h"
+#include "rpas/unit_check.h"
 
 #define MS 1000000LL
 
@@ -566,5 +566,5 @@ int main(void)
     RUN(test_speed_protection_autopilot);
     RUN(test_bad_inputs_stay_finite);
     RUN(test_deterministic_replicas);
-    return NF_TEST_RESULT();
+    return UNIT_RESULT();
 }

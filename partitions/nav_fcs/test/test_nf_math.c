@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Unit tests of the nav_fcs numeric helpers: angle wrapping, limits, ISA true airspeed. */
 #include "nf_math.h"
-#include "nf_test.h"
+#include "rpas/unit_check.h"
 
 static void test_wrap180(void)
 {
@@ -53,5 +53,5 @@ int main(void)
     RUN(test_wrap360);
     RUN(test_limits);
     RUN(test_isa);
-    return NF_TEST_RESULT();
+    return UNIT_RESULT();
 }

@@ -5,7 +5,7 @@
 
 #include "nav.h"
 #include "nf_math.h"
-#include "nf_test.h"
+#include "rpas/unit_check.h"
 
 #define MS 1000000LL
 #define LAT0 43.6
@@ -307,5 +307,5 @@ int main(void)
     RUN(test_stale_or_bad_gps_rejected);
     RUN(test_no_dead_reckoning_without_a_first_fix);
     RUN(test_ahrs_and_air_monitoring);
-    return NF_TEST_RESULT();
+    return UNIT_RESULT();
 }

@@ -1,0 +1,125 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Unit tests of io's CAN transmit: the frames go out on this node's redundancy channel, decode
+ * (with the DBC's codecs) to what nav_fcs wrote, clamped to the DBC's ranges; the command the
+ * others will see is reported; the test switch offsets one axis from its time on. */
+#include <math.h>
+#include <string.h>
+
+#include "io_core.h"
+#include "rpas/unit_check.h"
+#include "rpas_can.h"
+
+static io_outputs_t outputs(void)
+{
+    io_outputs_t o;
+    memset(&o, 0, sizeof o);
+    o.have_cmd = o.have_status = o.have_nav = true;
+    o.cmd = (rpas_act_cmd_msg_t){.seq = 17, .elev = 0.2, .ail = -0.1, .rud = 0.05, .thr = 0.7};
+    o.status = (rpas_fcs_status_msg_t){.mode = 2, .req_mode = 2, .lat_mode = 1, .tgt_hdg_deg = -90,
+                                       .tgt_alt_ft = 3000};
+    o.nav = (rpas_nav_msg_t){.lat_deg = 47.5, .lon_deg = -122.25, .alt_ft = 3010, .gs_kt = 110,
+                             .wind_n_kt = 0, .wind_e_kt = 10};
+    return o;
+}
+
+static void test_frames_on_the_node_channel(void)
+{
+    io_outputs_t o = outputs();
+    io_frame_t f[IO_TX_MAX_FRAMES];
+    double sent[IO_AXES] = {0};
+    int n = io_tx_frames(&o, 2, 4, f, sent); /* channel C, an even frame: NAV too */
+    CHECK(n == 4);
+    CHECK(f[0].id == RPAS_CAN_ACT_CMD_C_FRAME_ID && f[1].id == RPAS_CAN_FCS_STATUS_C_FRAME_ID);
+    CHECK(f[2].id == RPAS_CAN_NAV_POS_C_FRAME_ID && f[3].id == RPAS_CAN_NAV_DATA_C_FRAME_ID);
+    for (int i = 0; i < n; i++)
+        CHECK(f[i].len == 8);
+    struct rpas_can_act_cmd_a_t c;
+    CHECK(rpas_can_act_cmd_a_unpack(&c, f[0].data, 8) == 0);
+    CHECK_NEAR(rpas_can_act_cmd_a_elev_cmd_a_decode(c.elev_cmd_a), 0.2, 1e-3);
+    CHECK(c.cmd_cnt_a == (17 & 0xF));
+    CHECK_NEAR(sent[0], rpas_can_act_cmd_a_elev_cmd_a_decode(c.elev_cmd_a), 0);
+    CHECK_NEAR(sent[3], rpas_can_act_cmd_a_thr_cmd_a_decode(c.thr_cmd_a), 0);
+    struct rpas_can_fcs_status_a_t s;
+    CHECK(rpas_can_fcs_status_a_unpack(&s, f[1].data, 8) == 0);
+    CHECK(s.fcs_mode_a == 2 && s.fcs_lat_mode_a == 1 && s.fcs_cnt_a == 4);
+    CHECK_NEAR(rpas_can_fcs_status_a_fcs_tgt_hdg_a_decode(s.fcs_tgt_hdg_a), 270, 0.1); /* wrapped */
+    struct rpas_can_nav_data_a_t d;
+    CHECK(rpas_can_nav_data_a_unpack(&d, f[3].data, 8) == 0);
+    /* the air moves east: the wind blows from the west */
+    CHECK_NEAR(rpas_can_nav_data_a_nav_wind_dir_a_decode(d.nav_wind_dir_a), 270, 0.5);
+    CHECK_NEAR(rpas_can_nav_data_a_nav_wind_spd_a_decode(d.nav_wind_spd_a), 10, 0.1);
+    /* an odd frame: no navigation frames */
+    CHECK(io_tx_frames(&o, 2, 5, f, sent) == 2);
+}
+
+static void test_clamped(void)
+{
+    io_outputs_t o = outputs();
+    o.cmd.elev = 7.0;
+    o.cmd.ail = NAN;
+    o.cmd.thr = -3;
+    o.status.tgt_hdg_deg = NAN;
+    o.nav.lat_deg = 123;
+    io_frame_t f[IO_TX_MAX_FRAMES];
+    double sent[IO_AXES];
+    io_tx_frames(&o, 0, 0, f, sent);
+    CHECK_NEAR(sent[0], 1.0, 1e-3);
+    CHECK_NEAR(sent[1], 0.0, 1e-3); /* NaN: the neutral value */
+    CHECK_NEAR(sent[3], 0.0, 1e-3);
+    struct rpas_can_fcs_status_a_t s;
+    rpas_can_fcs_status_a_unpack(&s, f[1].data, 8);
+    CHECK_NEAR(rpas_can_fcs_status_a_fcs_tgt_hdg_a_decode(s.fcs_tgt_hdg_a), 0, 0.1);
+    struct rpas_can_nav_pos_a_t p;
+    rpas_can_nav_pos_a_unpack(&p, f[2].data, 8);
+    CHECK_NEAR(rpas_can_nav_pos_a_nav_lat_a_decode(p.nav_lat_a), 90, 1e-5);
+}
+
+static void test_nothing_to_send(void)
+{
+    io_outputs_t o;
+    memset(&o, 0, sizeof o);
+    io_frame_t f[IO_TX_MAX_FRAMES];
+    double sent[IO_AXES] = {9, 9, 9, 9};
+    CHECK(io_tx_frames(&o, 0, 0, f, sent) == 0);
+    CHECK(sent[0] == 9); /* untouched without a command */
+}
+
+static void test_bias_switch(void)
+{
+    io_settings_t s;
+    memset(&s, 0, sizeof s);
+    s.bias_axis = 0;
+    s.bias_value = 0.3;
+    s.bias_from_ns = 1000;
+    rpas_act_cmd_msg_t c = {.elev = 0.1};
+    io_cmd_bias(&s, 999, &c);
+    CHECK_NEAR(c.elev, 0.1, 0);
+    io_cmd_bias(&s, 1000, &c);
+    CHECK_NEAR(c.elev, 0.4, 1e-12);
+    s.bias_axis = -1;
+    io_cmd_bias(&s, 5000, &c);
+    CHECK_NEAR(c.elev, 0.4, 1e-12);
+}
+
+static void test_telemetry(void)
+{
+    io_outputs_t o = outputs();
+    struct xch_telemetry tm;
+    io_telemetry(&o, &tm);
+    CHECK(tm.fcs_mode == 2);
+    CHECK_NEAR(tm.lat_deg, 47.5, 0);
+    CHECK_NEAR(tm.cmd[3], 0.7, 0);
+    o.have_cmd = false;
+    io_telemetry(&o, &tm);
+    CHECK(tm.cmd[3] == 0);
+}
+
+int main(void)
+{
+    RUN(test_frames_on_the_node_channel);
+    RUN(test_clamped);
+    RUN(test_nothing_to_send);
+    RUN(test_bias_switch);
+    RUN(test_telemetry);
+    return UNIT_RESULT();
+}

@@ -53,7 +53,9 @@ def test_roundtrips():
     assert (r.type, r.flags, r.len, r.id, r.t_ns, r.data[:2]) == (1, 1, 2, 0x1234567, 42, b"\1\2")
 
 
-def test_frame_bits_matches_the_design_formula():
-    # DESIGN.md §3: g + 8s + 13 + floor((g + 8s - 1) / 4)
+def test_frame_bits_matches_the_worst_case_formula():
+    # The worst-case stuffed frame length of Davis et al., "Controller Area Network (CAN)
+    # schedulability analysis: refuted, revisited and revised" (2007):
+    # g + 8s + 13 + floor((g + 8s - 1) / 4), g = 34 (11-bit identifier) or 54 (29-bit)
     assert proto.frame_bits(True, 8) == 54 + 64 + 13 + (54 + 64 - 1) // 4 == 160
     assert proto.frame_bits(False, 0) == 34 + 13 + 33 // 4 == 55

@@ -104,6 +104,7 @@ static void test_names(void)
     CHECK(hm_apex_error_code(HM_ERR_MEMORY_VIOLATION) == 5);
     CHECK(hm_apex_error_code(HM_ERR_POWER_FAIL) == 7);
     CHECK(hm_apex_error_code(HM_ERR_WINDOW_OVERRUN) == 0); /* a deadline missed */
+    CHECK(hm_apex_error_code(HM_ERR_PARTITION_EXIT) == 6); /* HARDWARE_FAULT: no code of its own */
 }
 
 int main(void)

@@ -640,43 +640,32 @@ static int apply_partition_action(ske_t *s, part_t *p, hm_action_t action, int64
     }
 }
 
-/* Decides and applies what an error detected at partition or module level leads to. The
- * level comes from the SKE's own copy of the System HM table, never from the partition. */
-static int hm_handle(ske_t *s, part_t *p, int64_t t, hm_error_t e, hm_state_t state, int32_t process,
-                     const char *pname, const char *msg, size_t mlen, bool fatal, char *err,
-                     size_t errlen)
+/* Applies the health monitor's decision on an error that reached the SKE: the partition could
+ * not handle it, or the SKE detected it itself. The decision is hm_decide's, from the SKE's own
+ * copy of the tables, never from the partition's. */
+static int hm_handle(ske_t *s, part_t *p, int64_t t, hm_error_t e, hm_state_t state,
+                     hm_origin_t origin, int32_t process, const char *pname, const char *msg,
+                     size_t mlen, bool fatal, char *err, size_t errlen)
 {
-    hm_level_t level = hm_level_of(&s->cfg->hm, state, e);
-    const char *note = NULL;
-    if (level == HM_LEVEL_PROCESS) {
-        level = HM_LEVEL_PARTITION; /* no error handler could take it: the standard escalates */
-        note = "no process-level handling possible: escalated to the partition level";
+    /* Whatever reaches the SKE no error handler could take. A partition already ended has no
+     * context left that could hang. */
+    hm_decision_t d = hm_decide(&s->cfg->hm, &p->cfg->hm, state, e, origin, false,
+                                fatal && alive(p));
+    /* A module decision is the module's; what it leaves to the partition is told apart. */
+    bool module_note = d.level == HM_LEVEL_MODULE && d.note;
+    trace_hm(s, t, p, e, d.level, d.action, state, process, pname, msg, mlen,
+             module_note ? NULL : d.note);
+    if (d.level == HM_LEVEL_MODULE && d.action == HM_ACT_SHUTDOWN)
+        s->hm_shutdown = true;
+    else if (d.level == HM_LEVEL_MODULE && d.action == HM_ACT_RESET)
+        s->hm_reset = true;
+    if (module_note) {
+        ske_trace_begin(&s->trace, t, "ske", "hm_note");
+        ske_trace_str(&s->trace, "partition", p->cfg->name);
+        ske_trace_str(&s->trace, "note", d.note);
+        ske_trace_end(&s->trace);
     }
-    if (level == HM_LEVEL_MODULE) {
-        hm_action_t a = hm_module_action(&s->cfg->hm, state, e);
-        trace_hm(s, t, p, e, level, a, state, process, pname, msg, mlen, note);
-        if (a == HM_ACT_SHUTDOWN)
-            s->hm_shutdown = true;
-        else if (a == HM_ACT_RESET)
-            s->hm_reset = true;
-        else if (fatal) {
-            ske_trace_begin(&s->trace, t, "ske", "hm_note");
-            ske_trace_str(&s->trace, "partition", p->cfg->name);
-            ske_trace_str(&s->trace, "note", "module IGNORE, but the failed initialisation cannot go "
-                                             "on: the partition is idled");
-            ske_trace_end(&s->trace);
-            return apply_partition_action(s, p, HM_ACT_IDLE, t, err, errlen);
-        }
-        return SKE_OK;
-    }
-    hm_action_t a = hm_partition_action(&p->cfg->hm, state, e);
-    if (a == HM_ACT_IGNORE && fatal && alive(p)) {
-        /* The failed context cannot go on: ignoring would leave the partition hung. */
-        note = "IGNORE requested, but the failed initialisation cannot go on: the partition is idled";
-        a = HM_ACT_IDLE;
-    }
-    trace_hm(s, t, p, e, level, a, state, process, pname, msg, mlen, note);
-    return apply_partition_action(s, p, a, t, err, errlen);
+    return apply_partition_action(s, p, d.partition_action, t, err, errlen);
 }
 
 /* An error the partition posted (partition or module level). Every field is checked. */
@@ -700,7 +689,11 @@ static int hm_take_post(ske_t *s, part_t *p, int64_t t, char *err, size_t errlen
         return SKE_OK; /* not an error a partition can report */
     /* The failed process's name; none for the initialisation process (the error handler,
      * whose identifier is 0 too, has one). */
-    return hm_handle(s, p, t, e, st, process, pname[0] ? pname : NULL, msg, mlen, fatal, err, errlen);
+    hm_origin_t origin = !pname[0]     ? HM_ORIGIN_PARTITION
+                         : process == 0 ? HM_ORIGIN_ERROR_HANDLER
+                                        : HM_ORIGIN_PROCESS;
+    return hm_handle(s, p, t, e, st, origin, process, pname[0] ? pname : NULL, msg, mlen, fatal,
+                     err, errlen);
 }
 
 /* Applies a pending module RESET: every partition starts again (ARINC 653 Part 1, 2.4.2). */
@@ -1041,8 +1034,8 @@ static int judge_exits(ske_t *s, int64_t t, char *err, size_t errlen)
                     ? snprintf(msg, sizeof msg, "killed by SIG%s",
                                sigabbrev_np(p->exit_code) ? sigabbrev_np(p->exit_code) : "?")
                     : snprintf(msg, sizeof msg, "exited with status %d", p->exit_code);
-        rc = hm_handle(s, p, t, HM_ERR_PARTITION_EXIT, partition_state(p), 0, NULL, msg,
-                       (size_t)n, false, err, errlen);
+        rc = hm_handle(s, p, t, HM_ERR_PARTITION_EXIT, partition_state(p), HM_ORIGIN_SKE, 0,
+                       NULL, msg, (size_t)n, false, err, errlen);
         if (rc != SKE_OK)
             return rc;
     }
@@ -1213,16 +1206,16 @@ static int run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen
     if (rc == SKE_OK && outside_ns > OUTSIDE_LIMIT_NS && alive(p)) {
         char msg[96];
         int n = snprintf(msg, sizeof msg, "used CPU between its windows before window %d", w->id);
-        rc = hm_handle(s, p, end, HM_ERR_WINDOW_OVERRUN, partition_state(p), 0, NULL, msg,
-                       (size_t)n, false, err, errlen);
+        rc = hm_handle(s, p, end, HM_ERR_WINDOW_OVERRUN, partition_state(p), HM_ORIGIN_SKE, 0,
+                       NULL, msg, (size_t)n, false, err, errlen);
     }
     if (rc == SKE_OK && r == W_OVERRUN && alive(p)) {
         char msg[80];
         int n = snprintf(msg, sizeof msg, "window %d kept past its end (budget %lld ns)", w->id,
                          (long long)w->duration_ns);
         /* IGNORE leaves it stopped until its next window; IDLE or a restart end it now. */
-        rc = hm_handle(s, p, end, HM_ERR_WINDOW_OVERRUN, partition_state(p), 0, NULL, msg,
-                       (size_t)n, false, err, errlen);
+        rc = hm_handle(s, p, end, HM_ERR_WINDOW_OVERRUN, partition_state(p), HM_ORIGIN_SKE, 0,
+                       NULL, msg, (size_t)n, false, err, errlen);
     }
     if (rc == SKE_OK)
         rc = judge_exits(s, end, err, errlen);

@@ -111,8 +111,8 @@ static void load_partition(ske_loader_t *L, const xmlNode *n)
         snprintf(p->criticality, sizeof p->criticality, "LEVEL_E");
     p->system_partition = ske__attr_bool(n, "SystemPartition", false);
     xmlChar *sch = xmlGetNsProp(n, (const xmlChar *)"ScheduleChange", (const xmlChar *)SKE_EXT_NS);
-    p->schedule_change = sch && (strcmp((const char *)sch,
-                                        "true") == 0 || strcmp((const char *)sch, "1") == 0);
+    p->schedule_change =
+        sch && (strcmp((const char *)sch, "true") == 0 || strcmp((const char *)sch, "1") == 0);
     if (sch)
         xmlFree(sch);
     ske__attr(n, "EntryPoint", p->entry_point, sizeof p->entry_point);

@@ -41,7 +41,11 @@ typedef struct {
     int index;
     pid_t pid;
     ske_pstate_t state;
-    int exit_code; /* exit status or signal number */
+    /* How its last process ended on its own, kept whatever the health monitor then did: the
+     * statistics report it (an exit with status 0 too). Cleared when a new process starts. */
+    bool ended;
+    bool ended_by_signal;
+    int exit_code; /* exit status, or signal number when ended_by_signal */
     int ctl_fd;
     ske_ctl_t *ctl;
     ske_portmem_t ports[SKE_MAX_PORTS];

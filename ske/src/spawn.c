@@ -193,6 +193,7 @@ static char **make_env(void)
 int ske__spawn(ske_t *s, ske_part_t *p, char *err, size_t errlen)
 {
     fill_ctl(s, p);
+    p->ended = false; /* a new process: the last one's end no longer describes the partition */
     char **envp = make_env();
     int pipefd[2];
     if (!envp || pipe2(pipefd, O_CLOEXEC) != 0) {
@@ -243,6 +244,8 @@ int ske__spawn(ske_t *s, ske_part_t *p, char *err, size_t errlen)
         if (w == pid) {
             p->pid = 0; /* reaped: never signal that pid again */
             p->state = WIFSIGNALED(st) ? SKE_PS_CRASHED : SKE_PS_EXITED;
+            p->ended = true;
+            p->ended_by_signal = WIFSIGNALED(st);
             p->exit_code = WIFSIGNALED(st) ? WTERMSIG(st) : WEXITSTATUS(st);
             snprintf(err, errlen, "partition '%s' (%s) %s before attaching to the SKE (%s %d)",
                      p->cfg->name, p->cfg->executable,
@@ -293,6 +296,8 @@ static void record_exit(ske_t *s, ske_part_t *p, int status)
     if (p->ctl && p->index == s->cur_partition)
         ske__drain_events(s, p, s->now_ns, s->win_end_ns);
     p->state = WIFSIGNALED(status) ? SKE_PS_CRASHED : SKE_PS_EXITED;
+    p->ended = true;
+    p->ended_by_signal = WIFSIGNALED(status);
     p->exit_code = WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status);
     p->pid = 0;
     p->exit_to_judge = true;

@@ -72,11 +72,13 @@ int ske__write_stats(ske_t *s, double wall_s)
                 nwin, per_frame, (unsigned long long)p->windows, p->cpu_ns,
                 (unsigned long long)p->overruns, (unsigned long long)p->restarts,
                 ske__pstate_name(p->state));
-        if (p->state == SKE_PS_EXITED || p->state == SKE_PS_CRASHED)
+        /* From how the process ended, not from the state: a partition idled after it ended
+         * still ended that way, and a failed restart is no crash of a process. */
+        if (p->ended)
             fprintf(f, "%d", p->exit_code);
         else
             fputs("null", f);
-        const char *sig = p->state == SKE_PS_CRASHED ? sigabbrev_np(p->exit_code) : NULL;
+        const char *sig = p->ended && p->ended_by_signal ? sigabbrev_np(p->exit_code) : NULL;
         fputs(",\"exit_signal\":", f);
         if (sig)
             fprintf(f, "\"%s\"", sig);

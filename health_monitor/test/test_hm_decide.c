@@ -7,15 +7,7 @@
 #include <string.h>
 
 #include "hm/hm.h"
-
-static int failures;
-#define CHECK(c)                                                                              \
-    do {                                                                                      \
-        if (!(c)) {                                                                           \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #c);             \
-            failures++;                                                                       \
-        }                                                                                     \
-    } while (0)
+#include "hm_test.h"
 
 static const hm_level_t levels[] = {HM_LEVEL_MODULE, HM_LEVEL_PARTITION, HM_LEVEL_PROCESS};
 static const hm_action_t module_actions[] = {HM_ACT_IGNORE, HM_ACT_SHUTDOWN, HM_ACT_RESET};
@@ -73,7 +65,7 @@ static void check_case(hm_state_t s, hm_error_t e, hm_level_t level, hm_action_t
               got.partition_action == want.partition_action && got.flags == want.flags &&
               (got.note != NULL) == (want.flags != 0);
     if (!ok) {
-        failures++;
+        hm_test_failures++;
         if (mismatches_shown++ < 20)
             fprintf(stderr,
                     "state %s error %s level %s module %s partition %s origin %d handler %d "
@@ -222,15 +214,10 @@ static void test_garbage(void)
     CHECK(d.level == HM_LEVEL_PARTITION && d.action == HM_ACT_IDLE);
 }
 
-int main(void)
+void hm_test_decide(void)
 {
     test_whole_table();
     test_cells_independent();
     test_by_hand();
     test_garbage();
-    if (failures)
-        fprintf(stderr, "%d check(s) failed\n", failures);
-    else
-        printf("test_hm_decide: all checks passed\n");
-    return failures ? 1 : 0;
 }

@@ -114,8 +114,8 @@ int hm_apex_error_code(hm_error_t err)
     /* ERROR_CODE_TYPE: DEADLINE_MISSED 0, APPLICATION_ERROR 1, NUMERIC_ERROR 2, ILLEGAL_REQUEST 3,
      * STACK_OVERFLOW 4, MEMORY_VIOLATION 5, HARDWARE_FAULT 6, POWER_FAIL 7. */
     switch (err) {
-    case HM_ERR_WINDOW_OVERRUN: return 0;
-    case HM_ERR_PARTITION_EXIT: return 6;
+    case HM_ERR_WINDOW_OVERRUN: return 0; /* a window's time is the partition's deadline */
+    case HM_ERR_PARTITION_EXIT: return 6; /* HARDWARE_FAULT: the standard has no code for an end */
     default: return err >= 1 && err <= HM_ERR_POWER_FAIL ? (int)err - 1 : 6;
     }
 }

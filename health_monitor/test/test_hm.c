@@ -1,19 +1,13 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Unit tests of the health-monitoring tables: defaults, look-ups over every state and error,
- * out-of-range entries, names. */
+/* Unit tests of the health monitor: the tables (defaults, look-ups over every state and
+ * error, out-of-range entries, names) here, the decisions in test_hm_decide.c. */
 #include <stdio.h>
 #include <string.h>
 
 #include "hm/hm.h"
+#include "hm_test.h"
 
-static int failures;
-#define CHECK(c)                                                                              \
-    do {                                                                                      \
-        if (!(c)) {                                                                           \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #c);             \
-            failures++;                                                                       \
-        }                                                                                     \
-    } while (0)
+int hm_test_failures;
 
 static void test_defaults(void)
 {
@@ -104,6 +98,7 @@ static void test_names(void)
     CHECK(hm_apex_error_code(HM_ERR_MEMORY_VIOLATION) == 5);
     CHECK(hm_apex_error_code(HM_ERR_POWER_FAIL) == 7);
     CHECK(hm_apex_error_code(HM_ERR_WINDOW_OVERRUN) == 0); /* a deadline missed */
+    CHECK(hm_apex_error_code(HM_ERR_PARTITION_EXIT) == 6); /* HARDWARE_FAULT: no code of its own */
 }
 
 int main(void)
@@ -112,9 +107,10 @@ int main(void)
     test_lookup_is_per_cell();
     test_out_of_range_entries();
     test_names();
-    if (failures)
-        fprintf(stderr, "%d check(s) failed\n", failures);
+    hm_test_decide();
+    if (hm_test_failures)
+        fprintf(stderr, "%d check(s) failed\n", hm_test_failures);
     else
         printf("test_hm: all checks passed\n");
-    return failures ? 1 : 0;
+    return hm_test_failures ? 1 : 0;
 }

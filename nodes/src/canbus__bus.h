@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The ima-canbus process: options, clients, the quantum loop (bus_server.c), JSON output
- * helpers (bus_json.c). */
+/* The ima-canbus process: options, clients, the bus and its entry points (bus_server.c,
+ * bus_loop.c; canbus__server.h for what its files share), JSON output helpers (bus_json.c). */
 #ifndef CANBUS__BUS_H
 #define CANBUS__BUS_H
 

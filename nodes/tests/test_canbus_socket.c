@@ -489,7 +489,7 @@ int main(int argc, char **argv)
     snprintf(t2, sizeof t2, "%s/trace2.jsonl", dir);
     scenario_main(dir, t1);
     scenario_main(dir, t2);
-    /* Same inputs, same trace (DESIGN.md §3). */
+    /* Same inputs, same trace: the bus is deterministic in emulated time (nodes/README.md). */
     static char a[1 << 20], b[1 << 20];
     int na = read_file(t1, a, sizeof a), nb = read_file(t2, b, sizeof b);
     CHECK(na > 0 && na == nb && memcmp(a, b, (size_t)na) == 0);

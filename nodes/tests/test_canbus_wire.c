@@ -18,7 +18,8 @@
         }                                                                                     \
     } while (0)
 
-/* The formula of DESIGN.md §3, written out again independently of proto.h. */
+/* The worst-case frame length formula of Davis et al., Controller Area Network
+ * schedulability analysis, 2007, written out again independently of proto.h. */
 static uint32_t formula_bits(int ext, uint32_t s)
 {
     uint32_t g = ext ? 54 : 34;

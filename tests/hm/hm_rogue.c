@@ -8,7 +8,8 @@
  *   a destination port, found in /proc/self/maps: only a system partition may open it),
  *   divide (integer division by zero), stack (overflow its stack), spin (keep the CPU),
  *   app_error (RAISE_APPLICATION_ERROR), deadline (miss its deadline), apex (an invalid
- *   address given to an APEX service), exit (exit(7): the partition's process ends).
+ *   address given to an APEX service), exit (exit(7): the partition's process ends), exit0
+ *   (exit(0): it ends with status 0).
  * AT: the release of process "rogue" at which it misbehaves (1 = its first); 0 = during the
  *   partition's initialisation, before NORMAL mode.
  * "handler": an error handler reports each error (GET_ERROR_STATUS) and STARTs the failed
@@ -136,6 +137,8 @@ static void misbehave(void)
         SEND_QUEUING_MESSAGE(out_port, (MESSAGE_ADDR_TYPE)outside, 8, 0, &rc);
     } else if (strcmp(fault, "exit") == 0) {
         exit(7);
+    } else if (strcmp(fault, "exit0") == 0) {
+        exit(0);
     }
     report("after %s rc=%d", fault, (int)rc);
 }

@@ -81,4 +81,50 @@ bool hm_error_parse(const char *s, hm_error_t *out);
 /* The APEX ERROR_CODE_TYPE value reported to an error handler for an error identifier. */
 int hm_apex_error_code(hm_error_t err);
 
+/* ---- decisions ------------------------------------------------------------------------- */
+
+/* Where an error was raised. Only an error of one of the partition's ARINC processes can be
+ * taken by its error handler (ARINC 653 Part 1, 2.4.2.3). */
+typedef enum {
+    HM_ORIGIN_PROCESS = 0, /* an ARINC process of the partition */
+    HM_ORIGIN_ERROR_HANDLER = 1, /* the error handler process itself */
+    HM_ORIGIN_PARTITION = 2, /* the partition outside any process: initialisation, scheduler */
+    HM_ORIGIN_SKE = 3, /* the SKE, about the partition: a window overrun, an exit */
+    HM_ORIGIN_COUNT = 4,
+} hm_origin_t;
+
+/* Why a decision is not the plain reading of the tables (hm_decision_t.flags). */
+enum {
+    /* PROCESS level, but no error handler can take the error: the partition level decides
+     * (ARINC 653 Part 1, 2.4.2.3). */
+    HM_DECIDE_ESCALATED = 1u << 0,
+    /* IGNORE configured, but the failed context cannot go on (a fault outside any process,
+     * where no process can be stopped in its place): the partition is idled, since ignoring
+     * would leave it hung. */
+    HM_DECIDE_CANNOT_GO_ON = 1u << 1,
+};
+
+typedef struct {
+    hm_level_t level; /* the level that handles the error */
+    /* That level's action: ERROR_HANDLER at PROCESS level; IGNORE, IDLE, WARM_START or
+     * COLD_START at PARTITION level; IGNORE, SHUTDOWN or RESET at MODULE level. */
+    hm_action_t action;
+    /* What becomes of the failed partition itself: IGNORE (it goes on), IDLE, WARM_START or
+     * COLD_START. IGNORE under a module SHUTDOWN or RESET, which act on the whole module. */
+    hm_action_t partition_action;
+    unsigned flags; /* HM_DECIDE_* */
+    const char *note; /* one sentence on the flags for the trace; NULL when flags is 0 */
+} hm_decision_t;
+
+/* The health monitor's decision on one error: its level in the System HM table for `state`,
+ * escalated to the partition level when no error handler can take it, then the Module or
+ * Partition HM table's action, IGNORE overridden when the failed context cannot go on.
+ * `part` may be NULL (a caller that only tells PROCESS level from the others: the partition's
+ * own APEX library); the default Partition HM table stands in for it. `has_error_handler`:
+ * the partition created one. `fatal_context`: the failed context cannot go on and no process
+ * can be stopped in its place. Pure: no state, no I/O, async-signal-safe. */
+hm_decision_t hm_decide(const hm_system_table_t *sys, const hm_partition_table_t *part,
+                        hm_state_t state, hm_error_t err, hm_origin_t origin,
+                        bool has_error_handler, bool fatal_context);
+
 #endif /* HM_HM_H */

@@ -147,7 +147,9 @@ _Static_assert(sizeof(struct canbus_welcome) == 48, "welcome is 48 bytes on the 
 _Static_assert(sizeof(struct canbus_rec) == 32, "a record is 32 bytes on the wire");
 
 /* Worst-case bit count of a data frame with `len` data bytes, stuff bits included
- * (DESIGN.md §3): g + 8s + 13 + floor((g + 8s - 1) / 4), g = 34 (11-bit) or 54 (29-bit). */
+ * (Davis et al., Controller Area Network schedulability analysis: refuted, revisited and
+ * revised, Real-Time Systems 35, 2007, §3): g + 8s + 13 + floor((g + 8s - 1) / 4), g = 34
+ * (11-bit) or 54 (29-bit). */
 static inline uint32_t canbus_frame_bits(int extended, uint32_t len)
 {
     uint32_t g = extended ? 54u : 34u;

@@ -38,10 +38,20 @@ static hm_state_t current_state(void)
     return HM_STATE_PROCESS;
 }
 
-static hm_level_t level_of(hm_state_t st, hm_error_t err)
+/* The health monitor's decision, from the partition's copy of the System HM table: only
+ * whether the error handler takes the error matters here, the SKE decides the rest. */
+static hm_decision_t decide(const apex_proc_t *failed, hm_state_t st, hm_error_t err, bool fatal)
 {
-    uint8_t l = apex__rt.ctl->hm_level[st][err];
-    return l <= HM_LEVEL_PROCESS ? (hm_level_t)l : HM_LEVEL_PARTITION;
+    const apex_rt_t *rt = &apex__rt;
+    _Static_assert(sizeof rt->ctl->hm_level == sizeof ((hm_system_table_t *)0)->level,
+                   "the control block's HM table has the health monitor's shape");
+    hm_system_table_t sys;
+    memcpy(sys.level, rt->ctl->hm_level, sizeof sys.level);
+    memset(sys.module_action, HM_ACT_IGNORE, sizeof sys.module_action);
+    hm_origin_t origin = !failed             ? HM_ORIGIN_PARTITION
+                         : failed == &rt->eh ? HM_ORIGIN_ERROR_HANDLER
+                                             : HM_ORIGIN_PROCESS;
+    return hm_decide(&sys, NULL, st, err, origin, rt->has_eh, fatal && !failed);
 }
 
 /* ---- the error handler -------------------------------------------------------------- */
@@ -123,8 +133,7 @@ static void raise_error(apex_proc_t *failed, hm_state_t st, hm_error_t err, cons
                         size_t len, uintptr_t address, bool fatal)
 {
     apex_rt_t *rt = &apex__rt;
-    hm_level_t level = level_of(st, err);
-    if (level == HM_LEVEL_PROCESS && rt->has_eh && failed && failed != &rt->eh) {
+    if (decide(failed, st, err, fatal).level == HM_LEVEL_PROCESS) {
         /* Process level: the error handler takes it (ARINC 653 Part 1, 2.4.2.3). */
         enqueue(err, failed->id, address, msg, len);
         trace_process_level(err, failed, msg, len);
@@ -144,8 +153,7 @@ static void raise_error(apex_proc_t *failed, hm_state_t st, hm_error_t err, cons
         }
         return;
     }
-    /* Partition or module level (a process-level error with no handler goes to the
-     * partition level, as the standard says). */
+    /* Partition or module level: the SKE decides again from its own copy of the tables. */
     post_and_wait(err, st, failed, msg, len, fatal && !failed);
     if (!fatal)
         return;

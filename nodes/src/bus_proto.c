@@ -1,0 +1,232 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The bus's side of the protocol of proto.h: hellos (welcome or refusal), and the records of
+ * welcomed clients (frames, DONE, STOP, FAULT), each checked before it is acted on. */
+#include "canbus__server.h"
+
+#include <string.h>
+
+void canbus__reject(canbus_bus_t *b, canbus_client_t *c, const char *reason)
+{
+    c->rejected++;
+    b->rejected++;
+    canbus__staged_reject(b, c, reason);
+    if (c->rejected > (uint64_t)b->o.max_rejects) {
+        b->garbage_kicks++;
+        canbus__client_leave(b, c, "garbage");
+    }
+}
+
+int canbus__members_count(const canbus_bus_t *b)
+{
+    int n = 0;
+    for (size_t i = 0; i < b->n_live; i++)
+        if (!b->live[i]->gone && (b->live[i]->member || b->live[i]->member_next))
+            n++;
+    return n;
+}
+
+static int indexed_live(const canbus_bus_t *b)
+{
+    int n = 0;
+    for (size_t i = 0; i < b->n_live; i++)
+        if (!b->live[i]->gone && b->live[i]->index >= 0)
+            n++;
+    return n;
+}
+
+static void refuse(canbus_bus_t *b, canbus_client_t *c, uint32_t reason, const char *why)
+{
+    canbus__line_head(&b->staged, b->t, "reject");
+    canbus_sb_str(&b->staged, ",\"name\":");
+    canbus_sb_mem(&b->staged, c->jname.p, c->jname.n);
+    canbus_sb_str(&b->staged, ",\"reason\":\"");
+    canbus_sb_str(&b->staged, why);
+    canbus_sb_str(&b->staged, "\"}\n");
+    canbus__send_stop(b, c, reason);
+    canbus__flush_queue(b, c);
+    canbus__client_leave(b, c, why);
+}
+
+void canbus__handle_hello(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p, size_t n)
+{
+    struct canbus_hello h;
+    if (n != sizeof h) {
+        canbus_sb_json_str(&c->jname, "", 0);
+        b->bad_hellos++;
+        refuse(b, c, CANBUS_STOP_BAD_HELLO, "bad_hello");
+        return;
+    }
+    memcpy(&h, p, sizeof h);
+    memcpy(c->name, h.name, CANBUS_NAME_LEN);
+    c->name[CANBUS_NAME_LEN] = '\0';
+    canbus_sb_json_str(&c->jname, c->name, CANBUS_NAME_LEN);
+    if (h.magic != CANBUS_MAGIC || h.version != CANBUS_VERSION ||
+        (h.roles & ~(CANBUS_ROLE_CAN | CANBUS_ROLE_LOCKSTEP | CANBUS_ROLE_OWN))) {
+        b->bad_hellos++;
+        refuse(b, c, CANBUS_STOP_BAD_HELLO, "bad_hello");
+        return;
+    }
+    bool lockstep = h.roles & CANBUS_ROLE_LOCKSTEP;
+    if (lockstep && b->started && canbus__members_count(b) >= b->o.lockstep_clients) {
+        b->late_joins++;
+        refuse(b, c, CANBUS_STOP_LATE_JOIN, "late_join");
+        return;
+    }
+    if (indexed_live(b) >= b->o.max_clients || b->next_index >= CANBUS_WIRE_MAX_CLIENTS) {
+        b->full++;
+        refuse(b, c, CANBUS_STOP_FULL, "full");
+        return;
+    }
+    c->index = -1;
+    for (size_t k = 0; k < b->o.n_order; k++)
+        if (!b->by_index[k] && strcmp(b->o.order[k], c->name) == 0) {
+            c->index = (int)k; /* its place in --client-order */
+            break;
+        }
+    if (c->index < 0)
+        c->index = b->next_index++;
+    c->roles = h.roles;
+    c->node = h.node;
+    b->by_index[c->index] = c;
+    if (lockstep) {
+        c->member = !b->started;
+        c->member_next = b->started;
+    }
+    struct canbus_welcome wl = {
+        .magic = CANBUS_MAGIC,
+        .version = CANBUS_VERSION,
+        .client = (uint16_t)c->index,
+        .bitrate = b->o.bitrate,
+        .flags = b->o.realtime ? CANBUS_WELCOME_REALTIME : 0,
+        .quantum_ns = b->o.quantum_ns,
+        .t_ns = !b->started ? 0 : c->member_next ? b->t_next : b->t,
+        .end_ns = b->o.end_ns,
+    };
+    canbus__client_send(b, c, &wl, sizeof wl);
+    if (c->roles & CANBUS_ROLE_CAN) {
+        canbus_wire_attach(&b->wire, (uint8_t)c->index, true);
+        canbus_wire_arm_recovery(&b->wire, (uint8_t)c->index, b->o.recover);
+    }
+    /* Command-line faults that name this client are bound to its index. */
+    for (size_t i = 0; i < b->o.n_faults && i < b->wire.n_faults; i++) {
+        canbus_fault_t *f = &b->wire.faults[i];
+        if (f->target == CANBUS_NOBODY && b->o.faults[i].target_name[0] &&
+            strcmp(b->o.faults[i].target_name, c->name) == 0)
+            f->target = (uint8_t)c->index;
+    }
+    canbus_sbuf_t *s = &c->staged;
+    canbus__line_head(s, wl.t_ns, "client_join");
+    canbus__sb_client(b, s, "name", (uint8_t)c->index);
+    canbus_sb_str(s, ",\"roles\":[");
+    const char *sep = "";
+    if (c->roles & CANBUS_ROLE_CAN) {
+        canbus_sb_str(s, "\"can\"");
+        sep = ",";
+    }
+    if (c->roles & CANBUS_ROLE_LOCKSTEP) {
+        canbus_sb_str(s, sep);
+        canbus_sb_str(s, "\"lockstep\"");
+        sep = ",";
+    }
+    if (c->roles & CANBUS_ROLE_OWN) {
+        canbus_sb_str(s, sep);
+        canbus_sb_str(s, "\"own\"");
+    }
+    canbus_sb_str(s, "],\"node_id\":");
+    canbus_sb_u64(s, c->node);
+    canbus_sb_str(s, "}\n");
+    canbus__info(b, "client %d (%s) joined, roles 0x%x", c->index, c->name, c->roles);
+}
+
+static void handle_fault(canbus_bus_t *b, canbus_client_t *c, const struct canbus_rec *r)
+{
+    canbus_fault_t f;
+    if (canbus_fault_from_rec(r, &f) || canbus_wire_add_fault(&b->wire, &f)) {
+        canbus__reject(b, c, "bad_fault");
+        return;
+    }
+    b->faults_armed++;
+    canbus_sbuf_t *s = &c->staged;
+    canbus__line_head(s, b->t, "fault");
+    canbus_sb_str(s, ",\"fault\":\"");
+    canbus_sb_str(s, canbus_fault_kind_name(f.kind));
+    canbus_sb_str(s, "\",\"target\":");
+    canbus_sb_u64(s, f.target);
+    canbus_sb_str(s, ",\"match_id\":");
+    canbus_sb_u64(s, f.match_id);
+    canbus_sb_str(s, ",\"from_ns\":");
+    canbus_sb_i64(s, f.from_ns);
+    canbus_sb_str(s, ",\"until_ns\":");
+    canbus_sb_i64(s, f.until_ns == INT64_MAX ? -1 : f.until_ns);
+    canbus__sb_client(b, s, "by", (uint8_t)c->index);
+    canbus_sb_str(s, "}\n");
+}
+
+void canbus__handle_records(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p, size_t n)
+{
+    for (size_t off = 0; off < n && !c->gone; off += sizeof(struct canbus_rec)) {
+        struct canbus_rec r;
+        memcpy(&r, p + off, sizeof r);
+        switch (r.type) {
+        case CANBUS_MSG_FRAME: {
+            if (!(c->roles & CANBUS_ROLE_CAN)) {
+                canbus__reject(b, c, "frame_without_can_role");
+                break;
+            }
+            if (r.len > 8) {
+                canbus__reject(b, c, "len");
+                break;
+            }
+            if (r.flags & ~(CANBUS_FRAME_EFF | CANBUS_FRAME_RTR)) {
+                canbus__reject(b, c, "flags");
+                break;
+            }
+            if (r.id > ((r.flags & CANBUS_FRAME_EFF) ? 0x1FFFFFFFu : 0x7FFu)) {
+                canbus__reject(b, c, "id");
+                break;
+            }
+            /* proto.h: LOCKSTEP clients stamp their frames (not before the quantum they are
+             * in); the bus stamps the others' with the current quantum's start. */
+            int64_t req = b->t;
+            if (c->roles & CANBUS_ROLE_LOCKSTEP) {
+                if (r.t_ns < b->t)
+                    c->clamped++;
+                else
+                    req = r.t_ns;
+            }
+            int rc = canbus_wire_submit(&b->wire, req, r.id, r.flags, r.len, r.data,
+                                        (uint8_t)c->index);
+            if (rc == CANBUS_WIRE_EFULL) {
+                c->overflow++; /* its controller's queue is full, as ENOBUFS on SocketCAN */
+                break;
+            }
+            if (rc) {
+                canbus__reject(b, c, "out_of_memory");
+                break;
+            }
+            c->tx++;
+            break;
+        }
+        case CANBUS_MSG_DONE:
+            if (!c->member || c->done || r.t_ns != b->t_next) {
+                canbus__reject(b, c, "bad_done");
+                break;
+            }
+            c->done = true;
+            break;
+        case CANBUS_MSG_STOP:
+            if (!b->stopping) {
+                b->stopping = true;
+                b->stop_reason = CANBUS_STOP_REQUESTED;
+                canbus_sbuf_t *s = &c->staged;
+                canbus__line_head(s, b->t, "stop_request");
+                canbus__sb_client(b, s, "by", (uint8_t)c->index);
+                canbus_sb_str(s, "}\n");
+                canbus__info(b, "client %d (%s) asked to stop", c->index, c->name);
+            }
+            break;
+        case CANBUS_MSG_FAULT: handle_fault(b, c, &r); break;
+        default: canbus__reject(b, c, "type"); break;
+        }
+    }
+}

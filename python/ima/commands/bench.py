@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from ima.commands.run import positive_int
 
@@ -38,10 +39,26 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     tri.add_argument("--json", action="store_true", help="print the results as JSON")
     tri.add_argument("--duration", type=positive_int, default=600, metavar="SECONDS",
                      help="emulated flight time (default 600)")
+    cmp_ = targets.add_parser(
+        "compare", help="a benchmark of this checkout against another checkout (the previous "
+        "main), alternating, pinned to one CPU; per-pair ratios and their median")
+    cmp_.add_argument("base", type=Path, metavar="CHECKOUT",
+                      help="the other checkout, built (e.g. a git worktree of the previous main)")
+    cmp_.add_argument("bench", choices=("ske", "flight", "triplex"), help="the benchmark")
+    cmp_.add_argument("--pairs", type=positive_int, default=5, metavar="N",
+                      help="alternating pairs of runs (default 5)")
+    cmp_.add_argument("--cpu", type=int, default=0, metavar="K",
+                      help="the CPU every run is pinned to (default 0; -1: not pinned)")
+    cmp_.add_argument("--json", action="store_true", help="print the results as JSON")
     return parser
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.target == "compare":
+        from ima.bench import compare
+
+        cpu = None if args.cpu < 0 else args.cpu
+        return compare.run(args.base, args.bench, args.pairs, cpu, args.json)
     if args.target == "ske":
         from ima.bench import ske
 

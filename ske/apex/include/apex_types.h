@@ -17,11 +17,14 @@
 #define SYSTEM_LIMIT_NUMBER_OF_SEMAPHORES 256 /* partition scope */
 #define SYSTEM_LIMIT_NUMBER_OF_EVENTS 256 /* partition scope */
 
-/* Base APEX types: 8-bit unsigned, 32-bit signed, 32-bit unsigned, 64-bit signed. */
+/* Base APEX types: 8-bit unsigned, 32-bit signed, 32-bit unsigned, 64-bit signed. The 64-bit one
+ * is long long, as the standard's C binding declares it (not int64_t, which is long on 64-bit
+ * Linux): applications written for other APEX implementations print times with %lld and keep
+ * them in long long variables. */
 typedef uint8_t APEX_BYTE;
 typedef int32_t APEX_INTEGER;
 typedef uint32_t APEX_UNSIGNED;
-typedef int64_t APEX_LONG_INTEGER;
+typedef long long APEX_LONG_INTEGER;
 
 typedef enum {
     NO_ERROR = 0, /* request valid and operation performed */

@@ -30,7 +30,7 @@ typedef struct {
     PROCESS_ID_TYPE id;
     PROCESS_STATE_TYPE state;
     PRIORITY_TYPE cur_prio;
-    SYSTEM_TIME_TYPE deadline_time;
+    int64_t deadline_time; /* INFINITE_TIME_VALUE: none */
     int64_t next_release; /* periodic: the next release point */
     int64_t wake_at; /* INT64_MAX: no time-out */
     apex_wait_t wait;

@@ -5,6 +5,10 @@
 
 #include <stdint.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Domain limits (implementation dependent). */
 #define SYSTEM_LIMIT_NUMBER_OF_PARTITIONS 32 /* module scope */
 #define SYSTEM_LIMIT_NUMBER_OF_MESSAGES 1048576 /* module scope */
@@ -50,5 +54,9 @@ typedef enum { FIFO = 0, PRIORITY = 1 } QUEUING_DISCIPLINE_TYPE;
 typedef APEX_LONG_INTEGER SYSTEM_TIME_TYPE;
 #define INFINITE_TIME_VALUE ((SYSTEM_TIME_TYPE)-1)
 #define INFINITE_SYSTEM_TIME_VALUE INFINITE_TIME_VALUE /* the older binding's name */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_TYPES */

@@ -9,6 +9,7 @@
 #include "apex_process.h"
 #include "apex_partition.h"
 #include "apex_sampling.h"
+#include "apex_sampling_ext.h"
 #include "apex_queuing.h"
 #include "apex_buffer.h"
 #include "apex_blackboard.h"

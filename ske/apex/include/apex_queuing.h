@@ -56,6 +56,11 @@ extern void GET_QUEUING_PORT_STATUS(
     /*out*/ QUEUING_PORT_STATUS_TYPE *QUEUING_PORT_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
 
+/* Discards the messages waiting in a destination port. */
+extern void CLEAR_QUEUING_PORT(
+    /*in */ QUEUING_PORT_ID_TYPE QUEUING_PORT_ID,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
 #ifdef __cplusplus
 }
 #endif

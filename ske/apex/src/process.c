@@ -86,7 +86,8 @@ void CREATE_PROCESS(
     apex_rt_t *rt = &apex__rt;
     if (!apex__enter(RETURN_CODE))
         return;
-    if (!apex__in_ok(ATTRIBUTES, sizeof *ATTRIBUTES) || !apex__out_ok(PROCESS_ID, sizeof *PROCESS_ID)) {
+    if (!apex__in_ok(ATTRIBUTES, sizeof *ATTRIBUTES) ||
+        !apex__out_ok(PROCESS_ID, sizeof *PROCESS_ID)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }

@@ -123,7 +123,8 @@ void CREATE_QUEUING_PORT(
 {
     if (!apex__enter(RETURN_CODE))
         return;
-    if (!apex__name_ok(QUEUING_PORT_NAME) || !apex__out_ok(QUEUING_PORT_ID, sizeof *QUEUING_PORT_ID)) {
+    if (!apex__name_ok(QUEUING_PORT_NAME) ||
+        !apex__out_ok(QUEUING_PORT_ID, sizeof *QUEUING_PORT_ID)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -277,7 +278,8 @@ void GET_QUEUING_PORT_ID(
 {
     if (!apex__enter(RETURN_CODE))
         return;
-    if (!apex__name_ok(QUEUING_PORT_NAME) || !apex__out_ok(QUEUING_PORT_ID, sizeof *QUEUING_PORT_ID)) {
+    if (!apex__name_ok(QUEUING_PORT_NAME) ||
+        !apex__out_ok(QUEUING_PORT_ID, sizeof *QUEUING_PORT_ID)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }

@@ -55,7 +55,8 @@ public:
     RETURN_CODE_TYPE send(const T &value) const
     {
         RETURN_CODE_TYPE rc;
-        SEND_BUFFER(id_, reinterpret_cast<MESSAGE_ADDR_TYPE>(const_cast<T *>(&value)), sizeof(T), 0, &rc);
+        auto *bytes = reinterpret_cast<MESSAGE_ADDR_TYPE>(const_cast<T *>(&value));
+        SEND_BUFFER(id_, bytes, sizeof(T), 0, &rc);
         return rc;
     }
     RETURN_CODE_TYPE receive(T &value, SYSTEM_TIME_TYPE time_out) const
@@ -63,7 +64,8 @@ public:
         MESSAGE_SIZE_TYPE length = 0;
         RETURN_CODE_TYPE rc;
         RECEIVE_BUFFER(id_, time_out, reinterpret_cast<MESSAGE_ADDR_TYPE>(&value), &length, &rc);
-        return rc == NO_ERROR && length != static_cast<MESSAGE_SIZE_TYPE>(sizeof(T)) ? INVALID_CONFIG : rc;
+        const bool whole = length == static_cast<MESSAGE_SIZE_TYPE>(sizeof(T));
+        return rc == NO_ERROR && !whole ? INVALID_CONFIG : rc;
     }
 
 private:
@@ -123,7 +125,8 @@ PROCESS_ID_TYPE create(const char *process_name, void (*entry)(), SYSTEM_TIME_TY
     attr.STACK_SIZE = 65536;
     attr.BASE_PRIORITY = priority;
     attr.DEADLINE = SOFT;
-    std::memcpy(attr.NAME, process_name, strnlen(process_name, sizeof attr.NAME)); /* no NUL needed */
+    /* A NAME_TYPE needs no NUL. */
+    std::memcpy(attr.NAME, process_name, strnlen(process_name, sizeof attr.NAME));
     PROCESS_ID_TYPE id = NULL_PROCESS_ID;
     RETURN_CODE_TYPE rc;
     CREATE_PROCESS(&attr, &id, &rc);

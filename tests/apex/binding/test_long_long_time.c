@@ -34,8 +34,9 @@ static void tick(void)
         GET_PARTITION_STATUS(&partition, &rc);
 
         char text[MAX_ERROR_MESSAGE_SIZE];
-        int len = snprintf(text, sizeof text, "tick %lld at %lld ns, deadline %lld ns, period %lld ns",
-                           n, now, *deadline, partition.PERIOD);
+        int len = snprintf(text, sizeof text,
+                           "tick %lld at %lld ns, deadline %lld ns, period %lld ns", n, now,
+                           *deadline, partition.PERIOD);
         say(text, len);
         WRITE_SAMPLING_MESSAGE(time_port, (MESSAGE_ADDR_TYPE)&now, sizeof now, &rc);
 

@@ -2,7 +2,8 @@
 /* RECEIVE_BUFFER (ARINC 653 Part 1, 3.7.2.1): every return code, from the initialisation
  * process and from processes; waiting receivers served in FIFO or priority order; a receive
  * from a full buffer takes in the first waiting sender's message and releases that sender.
- * LENGTH is 0 when no message was received and left alone on INVALID_PARAM. The partition period is 20 ms; its window is the
+ * LENGTH is 0 when no message was received and left alone on INVALID_PARAM. The partition
+ * period is 20 ms; its window is the
  * first 10 ms of it. */
 #include <stdint.h>
 

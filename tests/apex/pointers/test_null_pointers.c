@@ -87,7 +87,8 @@ static void handler(void);
       RECEIVE_QUEUING_MESSAGE(qp_dst, 0, msg, NULL, &rc))                                      \
     X(GET_QUEUING_PORT_ID__QUEUING_PORT_NAME, INVALID_PARAM,                                   \
       GET_QUEUING_PORT_ID(NULL, &id_out, &rc))                                                 \
-    X(GET_QUEUING_PORT_ID__QUEUING_PORT_ID, INVALID_PARAM, GET_QUEUING_PORT_ID("QP_SRC", NULL, &rc)) \
+    X(GET_QUEUING_PORT_ID__QUEUING_PORT_ID, INVALID_PARAM,                                     \
+      GET_QUEUING_PORT_ID("QP_SRC", NULL, &rc))                                                \
     X(GET_QUEUING_PORT_STATUS__QUEUING_PORT_STATUS, INVALID_PARAM,                             \
       GET_QUEUING_PORT_STATUS(qp_src, NULL, &rc))                                              \
     X(CREATE_BUFFER__BUFFER_NAME, INVALID_PARAM, CREATE_BUFFER(NULL, 16, 4, FIFO, &id_out, &rc)) \
@@ -98,7 +99,8 @@ static void handler(void);
     X(GET_BUFFER_ID__BUFFER_NAME, INVALID_PARAM, GET_BUFFER_ID(NULL, &id_out, &rc))           \
     X(GET_BUFFER_ID__BUFFER_ID, INVALID_PARAM, GET_BUFFER_ID("BUF", NULL, &rc))               \
     X(GET_BUFFER_STATUS__BUFFER_STATUS, INVALID_PARAM, GET_BUFFER_STATUS(buf_id, NULL, &rc))  \
-    X(CREATE_BLACKBOARD__BLACKBOARD_NAME, INVALID_PARAM, CREATE_BLACKBOARD(NULL, 16, &id_out, &rc)) \
+    X(CREATE_BLACKBOARD__BLACKBOARD_NAME, INVALID_PARAM,                                       \
+      CREATE_BLACKBOARD(NULL, 16, &id_out, &rc))                                               \
     X(CREATE_BLACKBOARD__BLACKBOARD_ID, INVALID_PARAM, CREATE_BLACKBOARD("BB2", 16, NULL, &rc)) \
     X(DISPLAY_BLACKBOARD__MESSAGE_ADDR, INVALID_PARAM, DISPLAY_BLACKBOARD(bb_id, NULL, 4, &rc)) \
     X(READ_BLACKBOARD__MESSAGE_ADDR, INVALID_PARAM, READ_BLACKBOARD(bb_id, 0, NULL, &len, &rc)) \
@@ -109,7 +111,8 @@ static void handler(void);
       GET_BLACKBOARD_STATUS(bb_id, NULL, &rc))                                                 \
     X(CREATE_SEMAPHORE__SEMAPHORE_NAME, INVALID_PARAM,                                         \
       CREATE_SEMAPHORE(NULL, 0, 1, FIFO, &id_out, &rc))                                        \
-    X(CREATE_SEMAPHORE__SEMAPHORE_ID, INVALID_PARAM, CREATE_SEMAPHORE("S2", 0, 1, FIFO, NULL, &rc)) \
+    X(CREATE_SEMAPHORE__SEMAPHORE_ID, INVALID_PARAM,                                           \
+      CREATE_SEMAPHORE("S2", 0, 1, FIFO, NULL, &rc))                                           \
     X(GET_SEMAPHORE_ID__SEMAPHORE_NAME, INVALID_PARAM, GET_SEMAPHORE_ID(NULL, &id_out, &rc))  \
     X(GET_SEMAPHORE_ID__SEMAPHORE_ID, INVALID_PARAM, GET_SEMAPHORE_ID("SEM", NULL, &rc))      \
     X(GET_SEMAPHORE_STATUS__SEMAPHORE_STATUS, INVALID_PARAM,                                   \
@@ -233,7 +236,8 @@ static SCHEDULE_STATUS_TYPE schedule_status;
     X(GET_SAMPLING_PORT_STATUS, GET_SAMPLING_PORT_STATUS(sp_src, &sp_status, NULL))            \
     X(READ_UPDATED_SAMPLING_MESSAGE,                                                           \
       READ_UPDATED_SAMPLING_MESSAGE(sp_dst, msg, &len, &updated, NULL))                        \
-    X(GET_SAMPLING_PORT_CURRENT_STATUS, GET_SAMPLING_PORT_CURRENT_STATUS(sp_dst, &sp_current, NULL)) \
+    X(GET_SAMPLING_PORT_CURRENT_STATUS,                                                        \
+      GET_SAMPLING_PORT_CURRENT_STATUS(sp_dst, &sp_current, NULL))                             \
     X(READ_SAMPLING_MESSAGE_CONDITIONAL,                                                       \
       READ_SAMPLING_MESSAGE_CONDITIONAL(sp_dst, 0, msg, &len, &t, NULL))                       \
     X(CREATE_QUEUING_PORT, CREATE_QUEUING_PORT("QP_SRC", 16, 4, SOURCE, FIFO, &id_out, NULL))  \
@@ -381,7 +385,8 @@ static void create_objects(void)
     CREATE_EVENT("EVT", &evt_id, &rc);
     setup_rc("CREATE_EVENT", rc);
     attr = process_attributes("worker", worker, 5, INFINITE_TIME_VALUE, INFINITE_TIME_VALUE);
-    attr_no_entry = process_attributes("no_entry", NULL, 5, INFINITE_TIME_VALUE, INFINITE_TIME_VALUE);
+    attr_no_entry =
+        process_attributes("no_entry", NULL, 5, INFINITE_TIME_VALUE, INFINITE_TIME_VALUE);
     proc_id = new_process("worker", worker, 5, INFINITE_TIME_VALUE);
 }
 

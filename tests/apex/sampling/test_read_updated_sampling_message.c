@@ -42,7 +42,8 @@ static void try_read(const char *check, SAMPLING_PORT_ID_TYPE id, RETURN_CODE_TY
     if (len != UNTOUCHED)
         n += (size_t)snprintf(written + n, sizeof written - n, "LENGTH=%d,", (int)len);
     if (updated != (UPDATED_TYPE)UNTOUCHED)
-        n += (size_t)snprintf(written + n, sizeof written - n, "UPDATED=%s,", updated_name(updated));
+        n += (size_t)snprintf(written + n, sizeof written - n, "UPDATED=%s,",
+                              updated_name(updated));
     if (memcmp(msg, before, sizeof msg) != 0)
         snprintf(written + n, sizeof written - n, "MESSAGE=%s,",
                  message_text(msg, len == UNTOUCHED ? (MESSAGE_SIZE_TYPE)sizeof msg : len));

@@ -28,6 +28,7 @@ GROUPS = {
     "apex_process.h": "Process management (Part 1, 3.3)",
     "apex_time.h": "Time management (Part 1, 3.4)",
     "apex_sampling.h": "Sampling ports (Part 1, 3.6.2.1)",
+    "apex_sampling_ext.h": "Sampling port extensions (Part 2)",
     "apex_queuing.h": "Queuing ports (Part 1, 3.6.2.2)",
     "apex_buffer.h": "Buffers (Part 1, 3.7.2.1)",
     "apex_blackboard.h": "Blackboards (Part 1, 3.7.2.2)",

@@ -97,6 +97,18 @@ static inline const char *empty_indicator_name(EMPTY_INDICATOR_TYPE e)
     return enum_name(names, 2, e);
 }
 
+static inline const char *updated_name(UPDATED_TYPE u)
+{
+    static const char *const names[] = {"EMPTY_PORT", "CONSUMED_MESSAGE", "NEW_MESSAGE"};
+    return enum_name(names, 3, u);
+}
+
+static inline const char *age_name(AGE_TYPE a)
+{
+    static const char *const names[] = {"STALE", "FRESH"};
+    return enum_name(names, 2, a);
+}
+
 static inline const char *event_state_name(EVENT_STATE_TYPE s)
 {
     static const char *const names[] = {"DOWN", "UP"};

@@ -212,6 +212,13 @@ void ske_sampling_write(void *mem, uint32_t max_size, const void *msg, uint32_t 
  * max_size so that a corrupted header cannot make the reader overrun its buffer. */
 bool ske_sampling_read(const void *mem, uint32_t max_size, void *msg, uint32_t *len,
                        int64_t *t_ns);
+/* The same, also giving the message's sequence number (1, 2, ... per write): a reader tells a
+ * message it has read already from a new one by it. */
+bool ske_sampling_read_seq(const void *mem, uint32_t max_size, void *msg, uint32_t *len,
+                           int64_t *t_ns, uint32_t *seq);
+/* The sequence number and time stamp of the latest message, without copying it; false when
+ * none was ever written. */
+bool ske_sampling_latest(const void *mem, uint32_t max_size, uint32_t *seq, int64_t *t_ns);
 
 void ske_queue_init(void *mem, uint32_t max_size, uint32_t capacity);
 /* Number of messages between tail and head, or UINT32_MAX if the indices are inconsistent. */

@@ -72,6 +72,13 @@ void ske_sampling_write(void *mem, uint32_t max_size, const void *msg, uint32_t 
 
 bool ske_sampling_read(const void *mem, uint32_t max_size, void *msg, uint32_t *len, int64_t *t_ns)
 {
+    uint32_t seq;
+    return ske_sampling_read_seq(mem, max_size, msg, len, t_ns, &seq);
+}
+
+bool ske_sampling_read_seq(const void *mem, uint32_t max_size, void *msg, uint32_t *len,
+                           int64_t *t_ns, uint32_t *seq_out)
+{
     const ske_sampling_hdr_t *h = mem;
     /* Partitions never run at the same time, but a writer stopped late after an overrun
      * might still be writing: if a new message was published while we copied, copy again. */
@@ -89,9 +96,22 @@ bool ske_sampling_read(const void *mem, uint32_t max_size, void *msg, uint32_t *
         if (atomic_load_explicit(&h->seq, memory_order_relaxed) == seq || tries >= 3) {
             *len = n;
             *t_ns = t;
+            *seq_out = seq;
             return true;
         }
     }
+}
+
+bool ske_sampling_latest(const void *mem, uint32_t max_size, uint32_t *seq_out, int64_t *t_ns)
+{
+    const ske_sampling_hdr_t *h = mem;
+    uint32_t seq = atomic_load_explicit(&h->seq, memory_order_acquire);
+    if (seq == 0)
+        return false;
+    const ske_slot_hdr_t *s = slot_at((void *)mem, sizeof(*h), max_size, seq & 1u);
+    *t_ns = *(const volatile int64_t *)&s->t_ns;
+    *seq_out = seq;
+    return true;
 }
 
 void ske_queue_init(void *mem, uint32_t max_size, uint32_t capacity)

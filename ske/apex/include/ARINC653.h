@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The whole ARINC 653 APEX C binding provided by the IMA Testbed: include this one. */
+/* The whole ARINC 653 APEX C binding provided by the IMA Testbed: include this one. Every header
+ * it includes declares its services extern "C", so C++ partitions include it as C ones do. */
 #ifndef ARINC653_H
 #define ARINC653_H
 
@@ -8,6 +9,7 @@
 #include "apex_process.h"
 #include "apex_partition.h"
 #include "apex_sampling.h"
+#include "apex_sampling_ext.h"
 #include "apex_queuing.h"
 #include "apex_buffer.h"
 #include "apex_blackboard.h"

@@ -7,6 +7,10 @@
 #include "apex_process.h"
 #include "apex_types.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define MAX_NUMBER_OF_BLACKBOARDS SYSTEM_LIMIT_NUMBER_OF_BLACKBOARDS
 
 typedef NAME_TYPE BLACKBOARD_NAME_TYPE;
@@ -51,5 +55,9 @@ extern void GET_BLACKBOARD_STATUS(
     /*in */ BLACKBOARD_ID_TYPE BLACKBOARD_ID,
     /*out*/ BLACKBOARD_STATUS_TYPE *BLACKBOARD_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_BLACKBOARD */

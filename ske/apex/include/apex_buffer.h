@@ -7,6 +7,10 @@
 #include "apex_process.h"
 #include "apex_types.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define MAX_NUMBER_OF_BUFFERS SYSTEM_LIMIT_NUMBER_OF_BUFFERS
 
 typedef NAME_TYPE BUFFER_NAME_TYPE;
@@ -50,5 +54,9 @@ extern void GET_BUFFER_STATUS(
     /*in */ BUFFER_ID_TYPE BUFFER_ID,
     /*out*/ BUFFER_STATUS_TYPE *BUFFER_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_BUFFER */

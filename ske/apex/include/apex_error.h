@@ -6,6 +6,10 @@
 #include "apex_process.h"
 #include "apex_types.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define MAX_ERROR_MESSAGE_SIZE 128
 typedef APEX_INTEGER ERROR_MESSAGE_SIZE_TYPE;
 typedef APEX_BYTE ERROR_MESSAGE_TYPE[MAX_ERROR_MESSAGE_SIZE];
@@ -48,5 +52,9 @@ extern void RAISE_APPLICATION_ERROR(
     /*in */ MESSAGE_ADDR_TYPE MESSAGE_ADDR,
     /*in */ ERROR_MESSAGE_SIZE_TYPE LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_ERROR */

@@ -6,6 +6,10 @@
 #include "apex_process.h"
 #include "apex_types.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define MAX_NUMBER_OF_EVENTS SYSTEM_LIMIT_NUMBER_OF_EVENTS
 
 typedef NAME_TYPE EVENT_NAME_TYPE;
@@ -44,5 +48,9 @@ extern void GET_EVENT_STATUS(
     /*in */ EVENT_ID_TYPE EVENT_ID,
     /*out*/ EVENT_STATUS_TYPE *EVENT_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_EVENT */

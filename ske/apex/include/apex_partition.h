@@ -6,6 +6,10 @@
 #include "apex_process.h"
 #include "apex_types.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define MAX_NUMBER_OF_PARTITIONS SYSTEM_LIMIT_NUMBER_OF_PARTITIONS
 
 typedef enum { IDLE = 0, COLD_START = 1, WARM_START = 2, NORMAL = 3 } OPERATING_MODE_TYPE;
@@ -36,5 +40,9 @@ extern void GET_PARTITION_STATUS(
 extern void SET_PARTITION_MODE(
     /*in */ OPERATING_MODE_TYPE OPERATING_MODE,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_PARTITION */

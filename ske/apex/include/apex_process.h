@@ -5,6 +5,10 @@
 
 #include "apex_types.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define MAX_NUMBER_OF_PROCESSES SYSTEM_LIMIT_NUMBER_OF_PROCESSES
 #define MIN_PRIORITY_VALUE 1
 #define MAX_PRIORITY_VALUE 239
@@ -96,5 +100,9 @@ extern void GET_PROCESS_STATUS(
     /*in */ PROCESS_ID_TYPE PROCESS_ID,
     /*out*/ PROCESS_STATUS_TYPE *PROCESS_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_PROCESS */

@@ -6,6 +6,10 @@
 #include "apex_process.h"
 #include "apex_types.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define MAX_NUMBER_OF_QUEUING_PORTS SYSTEM_LIMIT_NUMBER_OF_QUEUING_PORTS
 
 typedef NAME_TYPE QUEUING_PORT_NAME_TYPE;
@@ -51,5 +55,14 @@ extern void GET_QUEUING_PORT_STATUS(
     /*in */ QUEUING_PORT_ID_TYPE QUEUING_PORT_ID,
     /*out*/ QUEUING_PORT_STATUS_TYPE *QUEUING_PORT_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+/* Discards the messages waiting in a destination port. */
+extern void CLEAR_QUEUING_PORT(
+    /*in */ QUEUING_PORT_ID_TYPE QUEUING_PORT_ID,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_QUEUING */

@@ -5,6 +5,10 @@
 
 #include "apex_types.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define MAX_NUMBER_OF_SAMPLING_PORTS SYSTEM_LIMIT_NUMBER_OF_SAMPLING_PORTS
 
 typedef NAME_TYPE SAMPLING_PORT_NAME_TYPE;
@@ -48,5 +52,9 @@ extern void GET_SAMPLING_PORT_STATUS(
     /*in */ SAMPLING_PORT_ID_TYPE SAMPLING_PORT_ID,
     /*out*/ SAMPLING_PORT_STATUS_TYPE *SAMPLING_PORT_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_SAMPLING */

@@ -5,6 +5,10 @@
 
 #include "apex_types.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef APEX_INTEGER SCHEDULE_ID_TYPE;
 typedef NAME_TYPE SCHEDULE_NAME_TYPE;
 
@@ -26,5 +30,9 @@ extern void GET_MODULE_SCHEDULE_ID(
     /*in */ const char *SCHEDULE_NAME,
     /*out*/ SCHEDULE_ID_TYPE *SCHEDULE_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_SCHEDULE */

@@ -6,6 +6,10 @@
 #include "apex_process.h"
 #include "apex_types.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define MAX_NUMBER_OF_SEMAPHORES SYSTEM_LIMIT_NUMBER_OF_SEMAPHORES
 #define MAX_SEMAPHORE_VALUE 32767
 
@@ -45,5 +49,9 @@ extern void GET_SEMAPHORE_STATUS(
     /*in */ SEMAPHORE_ID_TYPE SEMAPHORE_ID,
     /*out*/ SEMAPHORE_STATUS_TYPE *SEMAPHORE_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_SEMAPHORE */

@@ -5,6 +5,10 @@
 
 #include "apex_types.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 extern void TIMED_WAIT(
     /*in */ SYSTEM_TIME_TYPE DELAY_TIME,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
@@ -19,5 +23,9 @@ extern void GET_TIME(
 extern void REPLENISH(
     /*in */ SYSTEM_TIME_TYPE BUDGET_TIME,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_TIME */

@@ -5,6 +5,10 @@
 
 #include <stdint.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Domain limits (implementation dependent). */
 #define SYSTEM_LIMIT_NUMBER_OF_PARTITIONS 32 /* module scope */
 #define SYSTEM_LIMIT_NUMBER_OF_MESSAGES 1048576 /* module scope */
@@ -17,11 +21,14 @@
 #define SYSTEM_LIMIT_NUMBER_OF_SEMAPHORES 256 /* partition scope */
 #define SYSTEM_LIMIT_NUMBER_OF_EVENTS 256 /* partition scope */
 
-/* Base APEX types: 8-bit unsigned, 32-bit signed, 32-bit unsigned, 64-bit signed. */
+/* Base APEX types: 8-bit unsigned, 32-bit signed, 32-bit unsigned, 64-bit signed. The 64-bit one
+ * is long long, as the standard's C binding declares it (not int64_t, which is long on 64-bit
+ * Linux): applications written for other APEX implementations print times with %lld and keep
+ * them in long long variables. */
 typedef uint8_t APEX_BYTE;
 typedef int32_t APEX_INTEGER;
 typedef uint32_t APEX_UNSIGNED;
-typedef int64_t APEX_LONG_INTEGER;
+typedef long long APEX_LONG_INTEGER;
 
 typedef enum {
     NO_ERROR = 0, /* request valid and operation performed */
@@ -47,5 +54,9 @@ typedef enum { FIFO = 0, PRIORITY = 1 } QUEUING_DISCIPLINE_TYPE;
 typedef APEX_LONG_INTEGER SYSTEM_TIME_TYPE;
 #define INFINITE_TIME_VALUE ((SYSTEM_TIME_TYPE)-1)
 #define INFINITE_SYSTEM_TIME_VALUE INFINITE_TIME_VALUE /* the older binding's name */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* APEX_TYPES */

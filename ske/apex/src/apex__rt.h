@@ -30,7 +30,7 @@ typedef struct {
     PROCESS_ID_TYPE id;
     PROCESS_STATE_TYPE state;
     PRIORITY_TYPE cur_prio;
-    SYSTEM_TIME_TYPE deadline_time;
+    int64_t deadline_time; /* INFINITE_TIME_VALUE: none */
     int64_t next_release; /* periodic: the next release point */
     int64_t wake_at; /* INT64_MAX: no time-out */
     apex_wait_t wait;
@@ -71,6 +71,7 @@ typedef struct {
     QUEUING_DISCIPLINE_TYPE discipline;
     VALIDITY_TYPE last_validity;
     bool validity_known;
+    uint32_t read_seq; /* sampling: sequence number of the last message read here, 0: none */
 } apex_port_t;
 
 typedef struct {
@@ -147,6 +148,30 @@ bool apex__may_block(void);
 /* Brackets a copy from or to memory the caller named: a fault inside is an APEX service
  * given an invalid address, an ILLEGAL_REQUEST rather than a MEMORY_VIOLATION. */
 void apex__user_copy(bool on);
+/* The caller gave an address the service cannot use where it can return no error code (a
+ * null or unwritable RETURN_CODE), or one that faulted: an ILLEGAL_REQUEST for the health
+ * monitor, the same path as a fault inside apex__user_copy. The caller does not go on. */
+void apex__invalid_address(const void *address);
+
+/* The addresses a caller gives a service (user.c). Every service starts with apex__enter:
+ * it brings time up to date and checks RETURN_CODE; false means the service must return at
+ * once (the health monitor has the caller's ILLEGAL_REQUEST). The others are false for a null
+ * pointer, which a service answers with INVALID_PARAM; an address that cannot be read (or
+ * written, for an output) is an ILLEGAL_REQUEST, as when a message copy faults. */
+bool apex__enter(RETURN_CODE_TYPE *rc);
+bool apex__out_ok(void *p, size_t n);
+bool apex__in_ok(const void *p, size_t n);
+/* A name parameter: readable up to its NUL or MAX_NAME_LENGTH characters. */
+bool apex__name_ok(const char *name);
+
+/* Sampling ports (sampling.c), shared with the Part 2 extensions (sampling_ext.c). VALID when
+ * a message stamped `stamp` is at most port k's refresh period old now. */
+VALIDITY_TYPE apex__sampling_validity(int k, int64_t stamp);
+/* Copies destination port k's latest message into the caller's buffer; false when none was
+ * ever written. The message counts as read (READ_UPDATED_SAMPLING_MESSAGE), its validity is
+ * the port's LAST_MSG_VALIDITY, and a change of validity goes to the trace. */
+bool apex__sampling_take(int k, APEX_BYTE *buf, MESSAGE_SIZE_TYPE *len, int64_t *stamp);
+
 /* Health monitoring hooks of the run-time (hm.c). */
 void apex__hm_init(void);
 void apex__hm_check_deadlines(void);

@@ -19,12 +19,17 @@ void CREATE_BLACKBOARD(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_intra_t *in = &apex__intra;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(BLACKBOARD_NAME) || !apex__out_ok(BLACKBOARD_ID, sizeof *BLACKBOARD_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     if (in->n_blackboards >= MAX_NUMBER_OF_BLACKBOARDS) {
         *RETURN_CODE = INVALID_CONFIG;
         return;
     }
-    if (!apex__name_valid(BLACKBOARD_NAME) || !BLACKBOARD_ID) {
+    if (!apex__name_valid(BLACKBOARD_NAME)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -62,7 +67,8 @@ void DISPLAY_BLACKBOARD(
     /*in */ MESSAGE_SIZE_TYPE LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = blackboard_index(BLACKBOARD_ID);
     if (k < 0 || LENGTH > apex__intra.blackboards[k].max_size || LENGTH <= 0 || !MESSAGE_ADDR) {
         *RETURN_CODE = INVALID_PARAM;
@@ -93,10 +99,12 @@ void READ_BLACKBOARD(
     /*out*/ MESSAGE_SIZE_TYPE *LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = blackboard_index(BLACKBOARD_ID);
     int64_t until;
-    if (k < 0 || !apex__time_out(TIME_OUT, &until) || !MESSAGE_ADDR || !LENGTH) {
+    if (k < 0 || !apex__time_out(TIME_OUT, &until) || !MESSAGE_ADDR ||
+        !apex__out_ok(LENGTH, sizeof *LENGTH)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -107,11 +115,14 @@ void READ_BLACKBOARD(
         *RETURN_CODE = NO_ERROR;
         return;
     }
+    /* No message from here on: LENGTH 0, as for a queuing port. */
     if (TIME_OUT == 0) {
+        *LENGTH = 0;
         *RETURN_CODE = NOT_AVAILABLE;
         return;
     }
     if (!apex__may_block()) {
+        *LENGTH = 0;
         *RETURN_CODE = INVALID_MODE;
         return;
     }
@@ -121,8 +132,7 @@ void READ_BLACKBOARD(
     p->q_buf = MESSAGE_ADDR;
     p->q_len_out = &len;
     RETURN_CODE_TYPE rc = apex__wait_on(WAIT_BB_READ, k, until);
-    if (rc == NO_ERROR)
-        *LENGTH = len;
+    *LENGTH = rc == NO_ERROR ? len : 0; /* 0: TIMED_OUT */
     *RETURN_CODE = rc;
 }
 
@@ -130,7 +140,8 @@ void CLEAR_BLACKBOARD(
     /*in */ BLACKBOARD_ID_TYPE BLACKBOARD_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = blackboard_index(BLACKBOARD_ID);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -145,10 +156,13 @@ void GET_BLACKBOARD_ID(
     /*out*/ BLACKBOARD_ID_TYPE *BLACKBOARD_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
-    int k = -1;
-    if (BLACKBOARD_ID)
-        k = apex__find_named(apex__intra.blackboards, sizeof apex__intra.blackboards[0],
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(BLACKBOARD_NAME) || !apex__out_ok(BLACKBOARD_ID, sizeof *BLACKBOARD_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    int k = apex__find_named(apex__intra.blackboards, sizeof apex__intra.blackboards[0],
                              apex__intra.n_blackboards, BLACKBOARD_NAME);
     if (k < 0) {
         *RETURN_CODE = INVALID_CONFIG;
@@ -163,9 +177,10 @@ void GET_BLACKBOARD_STATUS(
     /*out*/ BLACKBOARD_STATUS_TYPE *BLACKBOARD_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = blackboard_index(BLACKBOARD_ID);
-    if (k < 0 || !BLACKBOARD_STATUS) {
+    if (k < 0 || !apex__out_ok(BLACKBOARD_STATUS, sizeof *BLACKBOARD_STATUS)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }

@@ -45,12 +45,17 @@ void CREATE_BUFFER(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_intra_t *in = &apex__intra;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(BUFFER_NAME) || !apex__out_ok(BUFFER_ID, sizeof *BUFFER_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     if (in->n_buffers >= MAX_NUMBER_OF_BUFFERS) {
         *RETURN_CODE = INVALID_CONFIG;
         return;
     }
-    if (!apex__name_valid(BUFFER_NAME) || !BUFFER_ID) {
+    if (!apex__name_valid(BUFFER_NAME)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -96,7 +101,8 @@ void SEND_BUFFER(
     /*in */ SYSTEM_TIME_TYPE TIME_OUT,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = buffer_index(BUFFER_ID);
     int64_t until;
     if (k < 0 || LENGTH > apex__intra.buffers[k].max_size || LENGTH <= 0 || !MESSAGE_ADDR ||
@@ -140,10 +146,12 @@ void RECEIVE_BUFFER(
     /*out*/ MESSAGE_SIZE_TYPE *LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = buffer_index(BUFFER_ID);
     int64_t until;
-    if (k < 0 || !apex__time_out(TIME_OUT, &until) || !MESSAGE_ADDR || !LENGTH) {
+    if (k < 0 || !apex__time_out(TIME_OUT, &until) || !MESSAGE_ADDR ||
+        !apex__out_ok(LENGTH, sizeof *LENGTH)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -161,11 +169,14 @@ void RECEIVE_BUFFER(
             apex__preempt_check();
         return;
     }
+    /* No message from here on: LENGTH 0, as for a queuing port. */
     if (TIME_OUT == 0) {
+        *LENGTH = 0;
         *RETURN_CODE = NOT_AVAILABLE;
         return;
     }
     if (!apex__may_block()) {
+        *LENGTH = 0;
         *RETURN_CODE = INVALID_MODE;
         return;
     }
@@ -175,8 +186,7 @@ void RECEIVE_BUFFER(
     p->q_buf = MESSAGE_ADDR;
     p->q_len_out = &len;
     RETURN_CODE_TYPE rc = apex__wait_on(WAIT_BUF_RECV, k, until);
-    if (rc == NO_ERROR)
-        *LENGTH = len;
+    *LENGTH = rc == NO_ERROR ? len : 0; /* 0: TIMED_OUT */
     *RETURN_CODE = rc;
 }
 
@@ -185,10 +195,13 @@ void GET_BUFFER_ID(
     /*out*/ BUFFER_ID_TYPE *BUFFER_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
-    int k = -1;
-    if (BUFFER_ID)
-        k = apex__find_named(apex__intra.buffers, sizeof apex__intra.buffers[0],
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(BUFFER_NAME) || !apex__out_ok(BUFFER_ID, sizeof *BUFFER_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    int k = apex__find_named(apex__intra.buffers, sizeof apex__intra.buffers[0],
                              apex__intra.n_buffers, BUFFER_NAME);
     if (k < 0) {
         *RETURN_CODE = INVALID_CONFIG;
@@ -203,9 +216,10 @@ void GET_BUFFER_STATUS(
     /*out*/ BUFFER_STATUS_TYPE *BUFFER_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = buffer_index(BUFFER_ID);
-    if (k < 0 || !BUFFER_STATUS) {
+    if (k < 0 || !apex__out_ok(BUFFER_STATUS, sizeof *BUFFER_STATUS)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }

@@ -8,7 +8,8 @@ void REPORT_APPLICATION_MESSAGE(
     /*in */ MESSAGE_SIZE_TYPE LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     if (LENGTH < 0 || LENGTH > MAX_ERROR_MESSAGE_SIZE || (LENGTH > 0 && !MESSAGE_ADDR)) {
         *RETURN_CODE = INVALID_PARAM;
         return;

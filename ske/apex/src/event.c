@@ -17,12 +17,17 @@ void CREATE_EVENT(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_intra_t *in = &apex__intra;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(EVENT_NAME) || !apex__out_ok(EVENT_ID, sizeof *EVENT_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     if (in->n_events >= MAX_NUMBER_OF_EVENTS) {
         *RETURN_CODE = INVALID_CONFIG;
         return;
     }
-    if (!apex__name_valid(EVENT_NAME) || !EVENT_ID) {
+    if (!apex__name_valid(EVENT_NAME)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -47,7 +52,8 @@ void SET_EVENT(
     /*in */ EVENT_ID_TYPE EVENT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = event_index(EVENT_ID);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -69,7 +75,8 @@ void RESET_EVENT(
     /*in */ EVENT_ID_TYPE EVENT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = event_index(EVENT_ID);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -84,7 +91,8 @@ void WAIT_EVENT(
     /*in */ SYSTEM_TIME_TYPE TIME_OUT,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = event_index(EVENT_ID);
     int64_t until;
     if (k < 0 || !apex__time_out(TIME_OUT, &until)) {
@@ -111,10 +119,13 @@ void GET_EVENT_ID(
     /*out*/ EVENT_ID_TYPE *EVENT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
-    int k = -1;
-    if (EVENT_ID)
-        k = apex__find_named(apex__intra.events, sizeof apex__intra.events[0],
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(EVENT_NAME) || !apex__out_ok(EVENT_ID, sizeof *EVENT_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    int k = apex__find_named(apex__intra.events, sizeof apex__intra.events[0],
                              apex__intra.n_events, EVENT_NAME);
     if (k < 0) {
         *RETURN_CODE = INVALID_CONFIG;
@@ -129,9 +140,10 @@ void GET_EVENT_STATUS(
     /*out*/ EVENT_STATUS_TYPE *EVENT_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = event_index(EVENT_ID);
-    if (k < 0 || !EVENT_STATUS) {
+    if (k < 0 || !apex__out_ok(EVENT_STATUS, sizeof *EVENT_STATUS)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }

@@ -226,6 +226,14 @@ static void on_fault(int sig, siginfo_t *si, void *uctx)
     raise_error(apex__rt.current, current_state(), err, msg, n > 0 ? (size_t)n : 0, addr, true);
 }
 
+void apex__invalid_address(const void *address)
+{
+    char msg[96];
+    int n = snprintf(msg, sizeof msg, "APEX service given an invalid address (%p)", address);
+    raise_error(apex__rt.current, current_state(), HM_ERR_ILLEGAL_REQUEST, msg,
+                n > 0 ? (size_t)n : 0, (uintptr_t)address, true);
+}
+
 void apex__hm_init(void)
 {
     /* Faults are handled on a stack of their own, so that a stack overflow can be. */
@@ -283,7 +291,8 @@ void CREATE_ERROR_HANDLER(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     if (rt->has_eh) {
         *RETURN_CODE = NO_ACTION;
         return;
@@ -329,7 +338,12 @@ void GET_ERROR_STATUS(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__out_ok(ERROR_STATUS, sizeof *ERROR_STATUS)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     if (!rt->has_eh || rt->current != &rt->eh) {
         *RETURN_CODE = INVALID_CONFIG; /* only the error handler may ask */
         return;
@@ -354,8 +368,10 @@ void RAISE_APPLICATION_ERROR(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
-    if (LENGTH < 0 || LENGTH > MAX_ERROR_MESSAGE_SIZE || (LENGTH > 0 && !MESSAGE_ADDR)) {
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (LENGTH < 0 || LENGTH > MAX_ERROR_MESSAGE_SIZE ||
+        (LENGTH > 0 && !apex__in_ok(MESSAGE_ADDR, (size_t)LENGTH))) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }

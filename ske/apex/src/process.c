@@ -84,8 +84,10 @@ void CREATE_PROCESS(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
-    if (!ATTRIBUTES) {
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__in_ok(ATTRIBUTES, sizeof *ATTRIBUTES) ||
+        !apex__out_ok(PROCESS_ID, sizeof *PROCESS_ID)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -162,7 +164,8 @@ void START(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     apex_proc_t *p = proc_by_id(PROCESS_ID);
     if (!p) {
         *RETURN_CODE = INVALID_PARAM;
@@ -216,7 +219,12 @@ void GET_MY_ID(
     /*out*/ PROCESS_ID_TYPE *PROCESS_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__out_ok(PROCESS_ID, sizeof *PROCESS_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     if (!apex__rt.current || apex__rt.current == &apex__rt.eh) {
         *RETURN_CODE = INVALID_MODE; /* the initialisation process and the error handler */
         return;
@@ -230,7 +238,12 @@ void GET_PROCESS_ID(
     /*out*/ PROCESS_ID_TYPE *PROCESS_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(PROCESS_NAME) || !apex__out_ok(PROCESS_ID, sizeof *PROCESS_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     for (int i = 0; i < apex__rt.n_procs; i++)
         if (same_name(apex__rt.procs[i].attr.NAME, PROCESS_NAME)) {
             *PROCESS_ID = apex__rt.procs[i].id;
@@ -245,9 +258,10 @@ void GET_PROCESS_STATUS(
     /*out*/ PROCESS_STATUS_TYPE *PROCESS_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     apex_proc_t *p = proc_by_id(PROCESS_ID);
-    if (!p) {
+    if (!p || !apex__out_ok(PROCESS_STATUS, sizeof *PROCESS_STATUS)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -284,7 +298,8 @@ void STOP(
     /*in */ PROCESS_ID_TYPE PROCESS_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     apex_proc_t *p = proc_by_id(PROCESS_ID);
     if (!p || p == apex__rt.current) {
         *RETURN_CODE = INVALID_PARAM; /* a process stops itself with STOP_SELF */
@@ -302,7 +317,8 @@ void SUSPEND_SELF(
     /*in */ SYSTEM_TIME_TYPE TIME_OUT,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     apex_proc_t *p = apex__rt.current;
     if (!apex__may_block()) {
         *RETURN_CODE = INVALID_MODE; /* preemption locked, error handler, initialisation */
@@ -333,7 +349,8 @@ void SUSPEND(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     apex_proc_t *p = proc_by_id(PROCESS_ID);
     if (!p || p == rt->current) {
         *RETURN_CODE = INVALID_PARAM; /* a process suspends itself with SUSPEND_SELF */
@@ -363,7 +380,8 @@ void RESUME(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     apex_proc_t *p = proc_by_id(PROCESS_ID);
     if (!p || p == rt->current) {
         *RETURN_CODE = INVALID_PARAM;
@@ -396,7 +414,8 @@ void SET_PRIORITY(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     apex_proc_t *p = proc_by_id(PROCESS_ID);
     if (!p || PRIORITY_VALUE < MIN_PRIORITY_VALUE || PRIORITY_VALUE > MAX_PRIORITY_VALUE) {
         *RETURN_CODE = INVALID_PARAM;
@@ -454,7 +473,8 @@ void DELAYED_START(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     apex_proc_t *p = proc_by_id(PROCESS_ID);
     if (!p) {
         *RETURN_CODE = INVALID_PARAM;
@@ -501,17 +521,18 @@ void LOCK_PREEMPTION(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__out_ok(LOCK_LEVEL, sizeof *LOCK_LEVEL)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     if (!current_is_process() || rt->mode != NORMAL) {
         *RETURN_CODE = NO_ACTION;
         return;
     }
     if (rt->lock_level >= MAX_LOCK_LEVEL) {
         *RETURN_CODE = INVALID_CONFIG;
-        return;
-    }
-    if (!LOCK_LEVEL) {
-        *RETURN_CODE = INVALID_PARAM;
         return;
     }
     rt->lock_level++;
@@ -525,13 +546,14 @@ void UNLOCK_PREEMPTION(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
-    if (!current_is_process() || rt->mode != NORMAL || rt->lock_level == 0) {
-        *RETURN_CODE = NO_ACTION;
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__out_ok(LOCK_LEVEL, sizeof *LOCK_LEVEL)) {
+        *RETURN_CODE = INVALID_PARAM;
         return;
     }
-    if (!LOCK_LEVEL) {
-        *RETURN_CODE = INVALID_PARAM;
+    if (!current_is_process() || rt->mode != NORMAL || rt->lock_level == 0) {
+        *RETURN_CODE = NO_ACTION;
         return;
     }
     if (--rt->lock_level == 0)

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* APEX queuing port services (ARINC 653 Part 1, 3.6.2.2). The source port's queue is
- * emptied by the SKE into the destination's at the end of the source's window; a full
- * destination queue loses the message and reports the overflow at the next receive. */
+/* APEX queuing port services (ARINC 653 Part 1, 3.6.2.2), CLEAR_QUEUING_PORT included. The
+ * source port's queue is emptied by the SKE into the destination's at the end of the
+ * source's window; a full destination queue loses the message and reports the overflow at
+ * the next receive. */
 #include <string.h>
 
 #include "apex__rt.h"
@@ -120,7 +121,13 @@ void CREATE_QUEUING_PORT(
     /*out*/ QUEUING_PORT_ID_TYPE *QUEUING_PORT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(QUEUING_PORT_NAME) ||
+        !apex__out_ok(QUEUING_PORT_ID, sizeof *QUEUING_PORT_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     int k = apex__port_by_name(QUEUING_PORT_NAME, SKE_PORT_QUEUING);
     if (k < 0) {
         *RETURN_CODE = INVALID_CONFIG;
@@ -162,7 +169,8 @@ void SEND_QUEUING_MESSAGE(
     /*in */ SYSTEM_TIME_TYPE TIME_OUT,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = apex__port_index(QUEUING_PORT_ID, SKE_PORT_QUEUING);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -213,10 +221,15 @@ void RECEIVE_QUEUING_MESSAGE(
     /*out*/ MESSAGE_SIZE_TYPE *LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!MESSAGE_ADDR || !apex__out_ok(LENGTH, sizeof *LENGTH)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     int k = apex__port_index(QUEUING_PORT_ID, SKE_PORT_QUEUING);
     int64_t until = INT64_MAX;
-    if (k < 0 || TIME_OUT < INFINITE_TIME_VALUE || !MESSAGE_ADDR || !LENGTH ||
+    if (k < 0 || TIME_OUT < INFINITE_TIME_VALUE ||
         (TIME_OUT > 0 && !apex__time_add(apex__now(), TIME_OUT, &until))) {
         *RETURN_CODE = INVALID_PARAM;
         return;
@@ -233,12 +246,16 @@ void RECEIVE_QUEUING_MESSAGE(
         *RETURN_CODE = rc;
         return;
     }
+    /* From here on no message is received: LENGTH 0, as the standard's pseudo-code sets it
+     * for an empty queue, a wait refused and a time-out. */
     if (TIME_OUT == 0) {
+        *LENGTH = 0;
         *RETURN_CODE = NOT_AVAILABLE;
         return;
     }
     apex_proc_t *p = apex__rt.current;
     if (!apex__may_block()) {
+        *LENGTH = 0;
         *RETURN_CODE = INVALID_MODE; /* the initialisation process, the error handler */
         return;
     }
@@ -250,8 +267,7 @@ void RECEIVE_QUEUING_MESSAGE(
     p->q_len_out = &len;
     p->wake_at = until;
     RETURN_CODE_TYPE rc = apex__block(p);
-    if (rc == NO_ERROR || rc == INVALID_CONFIG)
-        *LENGTH = len;
+    *LENGTH = rc == NO_ERROR || rc == INVALID_CONFIG ? len : 0; /* 0: TIMED_OUT */
     *RETURN_CODE = rc;
 }
 
@@ -260,7 +276,13 @@ void GET_QUEUING_PORT_ID(
     /*out*/ QUEUING_PORT_ID_TYPE *QUEUING_PORT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(QUEUING_PORT_NAME) ||
+        !apex__out_ok(QUEUING_PORT_ID, sizeof *QUEUING_PORT_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     int k = apex__port_by_name(QUEUING_PORT_NAME, SKE_PORT_QUEUING);
     if (k < 0 || !apex__rt.ports[k].created) {
         *RETURN_CODE = INVALID_CONFIG;
@@ -275,7 +297,12 @@ void GET_QUEUING_PORT_STATUS(
     /*out*/ QUEUING_PORT_STATUS_TYPE *QUEUING_PORT_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__out_ok(QUEUING_PORT_STATUS, sizeof *QUEUING_PORT_STATUS)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     int k = apex__port_index(QUEUING_PORT_ID, SKE_PORT_QUEUING);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -287,5 +314,28 @@ void GET_QUEUING_PORT_STATUS(
     QUEUING_PORT_STATUS->MAX_MESSAGE_SIZE = (MESSAGE_SIZE_TYPE)d->max_size;
     QUEUING_PORT_STATUS->PORT_DIRECTION = (PORT_DIRECTION_TYPE)d->dir;
     QUEUING_PORT_STATUS->WAITING_PROCESSES = apex__queue_waiters(k);
+    *RETURN_CODE = NO_ERROR;
+}
+
+void CLEAR_QUEUING_PORT(
+    /*in */ QUEUING_PORT_ID_TYPE QUEUING_PORT_ID,
+    /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
+{
+    if (!apex__enter(RETURN_CODE))
+        return;
+    int k = apex__port_index(QUEUING_PORT_ID, SKE_PORT_QUEUING);
+    if (k < 0) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    ske_port_desc_t *d = &apex__rt.ctl->ports[k];
+    if (d->dir != SKE_DIR_DESTINATION) {
+        *RETURN_CODE = INVALID_MODE;
+        return;
+    }
+    /* Everything that has arrived is consumed at once; an overflow before the clear concerned
+     * messages now discarded, so the next receive does not report it. */
+    atomic_store(&d->rx_tail, atomic_load(&qhdr(k)->head));
+    atomic_store(&d->overflow_ack, atomic_load(&qhdr(k)->overflows));
     *RETURN_CODE = NO_ERROR;
 }

@@ -93,6 +93,11 @@ __attribute__((constructor(101))) static void apex_attach(void)
         prctl(PR_SET_TIMERSLACK, 1UL); /* time-outs inside a window wake on time */
     rt->mode = (OPERATING_MODE_TYPE)rt->ctl->initial_mode;
     rt->seen_grant = 0;
+    /* Standard output is ima-ske's (a pipe or a file more often than a terminal), which the C
+     * library would buffer fully: a partition killed or restarted by the health monitor would
+     * lose what it printed, and partitions' lines would mix in 4 KiB pieces. Line buffering
+     * writes each complete line at once, in one write for lines up to 4 KiB. */
+    setvbuf(stdout, NULL, _IOLBF, 0);
     apex__ports_attach();
     apex__hm_init();
     if (apex__sandbox_install(rt->ctl) != 0)

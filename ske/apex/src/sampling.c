@@ -1,6 +1,35 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* APEX sampling port services (ARINC 653 Part 1, 3.6.2.1). */
+/* APEX sampling port services (ARINC 653 Part 1, 3.6.2.1), and the reading of a destination
+ * port's latest message that the Part 2 extensions (sampling_ext.c) share. */
 #include "apex__rt.h"
+
+VALIDITY_TYPE apex__sampling_validity(int k, int64_t stamp)
+{
+    /* Valid when the message's age is within the refresh period (Part 1, 2.3.5.3); a stamp
+     * from the future is a corrupted one: never valid. */
+    int64_t age = apex__now() - stamp;
+    return age >= 0 && age <= apex__rt.ctl->ports[k].refresh_ns ? VALID : INVALID;
+}
+
+bool apex__sampling_take(int k, APEX_BYTE *buf, MESSAGE_SIZE_TYPE *len, int64_t *stamp)
+{
+    const ske_port_desc_t *d = &apex__rt.ctl->ports[k];
+    apex_port_t *ap = &apex__rt.ports[k];
+    uint32_t n, seq;
+    apex__user_copy(true);
+    bool got = ske_sampling_read_seq(ap->mem, d->max_size, buf, &n, stamp, &seq);
+    apex__user_copy(false);
+    if (!got)
+        return false;
+    VALIDITY_TYPE v = apex__sampling_validity(k, *stamp);
+    if (!ap->validity_known || ap->last_validity != v)
+        apex__event(SKE_EV_PORT_VALIDITY, k, v, NULL, 0);
+    ap->validity_known = true;
+    ap->last_validity = v;
+    ap->read_seq = seq;
+    *len = (MESSAGE_SIZE_TYPE)n;
+    return true;
+}
 
 void CREATE_SAMPLING_PORT(
     /*in */ const char *SAMPLING_PORT_NAME,
@@ -10,7 +39,13 @@ void CREATE_SAMPLING_PORT(
     /*out*/ SAMPLING_PORT_ID_TYPE *SAMPLING_PORT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(SAMPLING_PORT_NAME) ||
+        !apex__out_ok(SAMPLING_PORT_ID, sizeof *SAMPLING_PORT_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     int k = apex__port_by_name(SAMPLING_PORT_NAME, SKE_PORT_SAMPLING);
     if (k < 0) {
         *RETURN_CODE = INVALID_CONFIG; /* no such port in the configuration */
@@ -46,7 +81,8 @@ void WRITE_SAMPLING_MESSAGE(
     /*in */ MESSAGE_SIZE_TYPE LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = apex__port_index(SAMPLING_PORT_ID, SKE_PORT_SAMPLING);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -78,37 +114,33 @@ void READ_SAMPLING_MESSAGE(
     /*out*/ VALIDITY_TYPE *VALIDITY,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
-    int k = apex__port_index(SAMPLING_PORT_ID, SKE_PORT_SAMPLING);
-    if (k < 0 || !MESSAGE_ADDR) {
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!MESSAGE_ADDR || !apex__out_ok(LENGTH, sizeof *LENGTH) ||
+        !apex__out_ok(VALIDITY, sizeof *VALIDITY)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
-    const ske_port_desc_t *d = &apex__rt.ctl->ports[k];
-    apex_port_t *ap = &apex__rt.ports[k];
-    if (d->dir != SKE_DIR_DESTINATION) {
+    int k = apex__port_index(SAMPLING_PORT_ID, SKE_PORT_SAMPLING);
+    if (k < 0) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    if (apex__rt.ctl->ports[k].dir != SKE_DIR_DESTINATION) {
         *RETURN_CODE = INVALID_MODE;
         return;
     }
-    uint32_t len;
-    int64_t t;
-    apex__user_copy(true);
-    bool got = ske_sampling_read(ap->mem, d->max_size, MESSAGE_ADDR, &len, &t);
-    apex__user_copy(false);
-    if (!got) {
-        *RETURN_CODE = NO_ACTION; /* no message was ever written */
+    MESSAGE_SIZE_TYPE len;
+    int64_t stamp;
+    if (!apex__sampling_take(k, MESSAGE_ADDR, &len, &stamp)) {
+        /* No message was ever written: the standard's empty port. */
+        *LENGTH = 0;
+        *VALIDITY = INVALID;
+        *RETURN_CODE = NO_ACTION;
         return;
     }
-    /* Valid when the message's age is within the refresh period (Part 1, 2.3.5.3). */
-    int64_t age = apex__now() - t;
-    /* A stamp from the future is a corrupted one: never valid. */
-    VALIDITY_TYPE v = age >= 0 && age <= d->refresh_ns ? VALID : INVALID;
-    if (!ap->validity_known || ap->last_validity != v)
-        apex__event(SKE_EV_PORT_VALIDITY, k, v, NULL, 0);
-    ap->validity_known = true;
-    ap->last_validity = v;
-    *LENGTH = (MESSAGE_SIZE_TYPE)len;
-    *VALIDITY = v;
+    *LENGTH = len;
+    *VALIDITY = apex__rt.ports[k].last_validity;
     *RETURN_CODE = NO_ERROR;
 }
 
@@ -117,7 +149,13 @@ void GET_SAMPLING_PORT_ID(
     /*out*/ SAMPLING_PORT_ID_TYPE *SAMPLING_PORT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(SAMPLING_PORT_NAME) ||
+        !apex__out_ok(SAMPLING_PORT_ID, sizeof *SAMPLING_PORT_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     int k = apex__port_by_name(SAMPLING_PORT_NAME, SKE_PORT_SAMPLING);
     if (k < 0 || !apex__rt.ports[k].created) {
         *RETURN_CODE = INVALID_CONFIG;
@@ -132,7 +170,12 @@ void GET_SAMPLING_PORT_STATUS(
     /*out*/ SAMPLING_PORT_STATUS_TYPE *SAMPLING_PORT_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__out_ok(SAMPLING_PORT_STATUS, sizeof *SAMPLING_PORT_STATUS)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     int k = apex__port_index(SAMPLING_PORT_ID, SKE_PORT_SAMPLING);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;

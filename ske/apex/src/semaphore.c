@@ -21,12 +21,17 @@ void CREATE_SEMAPHORE(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_intra_t *in = &apex__intra;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(SEMAPHORE_NAME) || !apex__out_ok(SEMAPHORE_ID, sizeof *SEMAPHORE_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     if (in->n_semaphores >= MAX_NUMBER_OF_SEMAPHORES) {
         *RETURN_CODE = INVALID_CONFIG;
         return;
     }
-    if (!apex__name_valid(SEMAPHORE_NAME) || !SEMAPHORE_ID) {
+    if (!apex__name_valid(SEMAPHORE_NAME)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -60,7 +65,8 @@ void WAIT_SEMAPHORE(
     /*in */ SYSTEM_TIME_TYPE TIME_OUT,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = semaphore_index(SEMAPHORE_ID);
     int64_t until;
     if (k < 0 || !apex__time_out(TIME_OUT, &until)) {
@@ -88,7 +94,8 @@ void SIGNAL_SEMAPHORE(
     /*in */ SEMAPHORE_ID_TYPE SEMAPHORE_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = semaphore_index(SEMAPHORE_ID);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -115,10 +122,13 @@ void GET_SEMAPHORE_ID(
     /*out*/ SEMAPHORE_ID_TYPE *SEMAPHORE_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
-    int k = -1;
-    if (SEMAPHORE_ID)
-        k = apex__find_named(apex__intra.semaphores, sizeof apex__intra.semaphores[0],
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__name_ok(SEMAPHORE_NAME) || !apex__out_ok(SEMAPHORE_ID, sizeof *SEMAPHORE_ID)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    int k = apex__find_named(apex__intra.semaphores, sizeof apex__intra.semaphores[0],
                              apex__intra.n_semaphores, SEMAPHORE_NAME);
     if (k < 0) {
         *RETURN_CODE = INVALID_CONFIG;
@@ -133,9 +143,10 @@ void GET_SEMAPHORE_STATUS(
     /*out*/ SEMAPHORE_STATUS_TYPE *SEMAPHORE_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     int k = semaphore_index(SEMAPHORE_ID);
-    if (k < 0 || !SEMAPHORE_STATUS) {
+    if (k < 0 || !apex__out_ok(SEMAPHORE_STATUS, sizeof *SEMAPHORE_STATUS)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }

@@ -8,7 +8,8 @@ void TIMED_WAIT(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     apex_proc_t *p = rt->current;
     if (!apex__may_block()) {
         *RETURN_CODE = INVALID_MODE; /* the initialisation process, the error handler */
@@ -34,7 +35,8 @@ void TIMED_WAIT(
 void PERIODIC_WAIT(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     apex_proc_t *p = apex__rt.current;
     if (!apex__may_block() || p->attr.PERIOD == INFINITE_TIME_VALUE) {
         *RETURN_CODE = INVALID_MODE;
@@ -50,7 +52,12 @@ void GET_TIME(
     /*out*/ SYSTEM_TIME_TYPE *SYSTEM_TIME,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
+    if (!apex__out_ok(SYSTEM_TIME, sizeof *SYSTEM_TIME)) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
     *SYSTEM_TIME = apex__now();
     *RETURN_CODE = NO_ERROR;
 }
@@ -60,7 +67,8 @@ void REPLENISH(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    apex__sync();
+    if (!apex__enter(RETURN_CODE))
+        return;
     apex_proc_t *p = rt->current;
     /* Nothing to replenish for the initialisation process, the error handler, or a process
      * with no time capacity (no deadline). */

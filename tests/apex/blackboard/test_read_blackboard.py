@@ -6,6 +6,8 @@ the clock), or a null address or LENGTH; NOT_AVAILABLE: the blackboard is empty 
 is 0; INVALID_MODE: the caller would have to wait and may not (preemption locked, the error
 handler, here also the initialisation process); TIMED_OUT: still empty when the time-out
 expires; NO_ERROR: the displayed message and its LENGTH, at once or when it is displayed.
+LENGTH is set to 0 when no message is read (NOT_AVAILABLE, INVALID_MODE, TIMED_OUT) and left
+alone on INVALID_PARAM (docs/apex-coverage.md, output parameters).
 """
 
 FRAMES = 1
@@ -16,6 +18,11 @@ def read(prefix, rc, text="-", length=UNTOUCHED):
     return {prefix: rc, f"{prefix}.message": text, f"{prefix}.length": length}
 
 
+def nothing(prefix, rc):
+    """No message read: LENGTH 0, the buffer as it was."""
+    return read(prefix, rc, "(empty)", 0)
+
+
 CHECKS = {
     "read_blackboard": {
         **read("init.id_zero", "INVALID_PARAM"),
@@ -23,17 +30,17 @@ CHECKS = {
         **read("init.timeout_minus_2", "INVALID_PARAM"),
         "init.null_address": "INVALID_PARAM",
         "init.null_length": "INVALID_PARAM",
-        **read("init.empty.no_wait", "NOT_AVAILABLE"),
-        **read("init.empty.would_wait", "INVALID_MODE"),
-        **read("init.empty.would_wait_forever", "INVALID_MODE"),
+        **nothing("init.empty.no_wait", "NOT_AVAILABLE"),
+        **nothing("init.empty.would_wait", "INVALID_MODE"),
+        **nothing("init.empty.would_wait_forever", "INVALID_MODE"),
         **read("init.occupied", "NO_ERROR", "hello", 5),
         **read("init.occupied.again", "NO_ERROR", "hello", 5),
         **read("normal.occupied", "NO_ERROR", "hello", 5),
-        **read("normal.empty.no_wait", "NOT_AVAILABLE"),
-        **read("normal.empty.timed_out", "TIMED_OUT"),
+        **nothing("normal.empty.no_wait", "NOT_AVAILABLE"),
+        **nothing("normal.empty.timed_out", "TIMED_OUT"),
         "normal.empty.timed_out.elapsed": 2_000_000,
         **read("normal.timeout_beyond_clock", "INVALID_PARAM"),
-        **read("normal.preemption_locked", "INVALID_MODE"),
+        **nothing("normal.preemption_locked", "INVALID_MODE"),
         **read("normal.preemption_locked.occupied", "NO_ERROR", "hello", 5),
         **read("normal.empty.wait", "NO_ERROR", "late", 4),
         "normal.empty.wait.elapsed": 3_000_000,

@@ -5,7 +5,8 @@
  * four messages on QP_FLOOD, whose destination queue holds two. dst checks every return code:
  * NO_ERROR, NOT_AVAILABLE, TIMED_OUT, INVALID_PARAM, INVALID_MODE (source port; the
  * initialisation process would have to wait), and INVALID_CONFIG after an overflow, with the
- * message still delivered. Outputs are written only on NO_ERROR (and on that INVALID_CONFIG). */
+ * message still delivered. When no message is received (NOT_AVAILABLE, TIMED_OUT, a wait
+ * refused) LENGTH is 0; on INVALID_PARAM and for a source port the outputs are left alone. */
 #include <stdint.h>
 
 #include "apex_check.h"
@@ -54,8 +55,8 @@ static void src_process(void)
     }
 }
 
-/* Receives and checks the return code, the length and the message; a refused receive must
- * leave LENGTH and the message buffer as they were. */
+/* Receives and checks the return code, the length and the message; a receive that gets no
+ * message reports which outputs it wrote ("LENGTH=<n>", "MESSAGE", or "none"). */
 static void try_receive(const char *check, QUEUING_PORT_ID_TYPE id, SYSTEM_TIME_TYPE timeout,
                         RETURN_CODE_TYPE expect, const char *text)
 {
@@ -76,7 +77,12 @@ static void try_receive(const char *check, QUEUING_PORT_ID_TYPE id, SYSTEM_TIME_
         for (size_t i = 0; i < sizeof msg; i++)
             buffer_touched |= msg[i] != 0x5A;
         snprintf(n, sizeof n, "%s.outputs_written", check);
-        check_str(n, "none", len != UNTOUCHED ? "LENGTH" : buffer_touched ? "MESSAGE" : "none");
+        char written[48] = "";
+        if (len != UNTOUCHED)
+            snprintf(written, sizeof written, "LENGTH=%d,", (int)len);
+        if (buffer_touched)
+            strcat(written, "MESSAGE,");
+        check_str(n, "*", written[0] ? written : "none");
     }
 }
 

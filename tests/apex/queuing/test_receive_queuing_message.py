@@ -7,7 +7,9 @@ destination, or the caller would have to wait and may not (the initialisation pr
 NOT_AVAILABLE: empty and TIME_OUT is 0; TIMED_OUT: still empty when the time-out expires;
 INVALID_CONFIG: the queue overflowed since the last receive (the message is still returned);
 NO_ERROR otherwise. Messages sent in the source's window reach the destination when that
-window ends.
+window ends. LENGTH is 0 when no message is received (NOT_AVAILABLE, TIMED_OUT, a wait
+refused with INVALID_MODE); INVALID_PARAM and the source port's INVALID_MODE leave every
+output alone (docs/apex-coverage.md, output parameters).
 """
 
 FRAMES = 2
@@ -15,6 +17,11 @@ FRAMES = 2
 
 def _refused(name: str, code: str) -> dict:
     return {name: code, f"{name}.outputs_written": "none"}
+
+
+def _nothing(name: str, code: str) -> dict:
+    """No message received: LENGTH 0 and nothing else written."""
+    return {name: code, f"{name}.outputs_written": "LENGTH=0,"}
 
 
 def _received(name: str, code: str, text: str) -> dict:
@@ -27,27 +34,27 @@ CHECKS = {
         "src.nb_message.in_window_b": 1,
     },
     "dst": {
-        **_refused("init.empty.would_wait", "INVALID_MODE"),
-        **_refused("init.empty.would_wait_forever", "INVALID_MODE"),
-        **_refused("init.empty.no_wait", "NOT_AVAILABLE"),
+        **_nothing("init.empty.would_wait", "INVALID_MODE"),
+        **_nothing("init.empty.would_wait_forever", "INVALID_MODE"),
+        **_nothing("init.empty.no_wait", "NOT_AVAILABLE"),
         **_refused("id_zero", "INVALID_PARAM"),
         **_refused("id_unknown", "INVALID_PARAM"),
         **_refused("timeout_minus_2", "INVALID_PARAM"),
         **_refused("source_port", "INVALID_MODE"),
         "nb_message": 1,
         **_received("received", "NO_ERROR", "A0"),
-        **_refused("empty.no_wait", "NOT_AVAILABLE"),
-        **_refused("empty.timed_out", "TIMED_OUT"),
+        **_nothing("empty.no_wait", "NOT_AVAILABLE"),
+        **_nothing("empty.timed_out", "TIMED_OUT"),
         "empty.timed_out.elapsed": 1_000_000,
         **_refused("timeout_beyond_clock", "INVALID_PARAM"),
         "timeout_beyond_clock.elapsed": 0,
         **_received("overflow", "INVALID_CONFIG", "F0"),
         **_received("overflow.next", "NO_ERROR", "F1"),
-        **_refused("overflow.lost", "NOT_AVAILABLE"),
+        **_nothing("overflow.lost", "NOT_AVAILABLE"),
         **_received("wait", "NO_ERROR", "B0"),
         "wait.received_at": 25_000_000,
         **_received("wait.next", "NO_ERROR", "A1"),
-        **_refused("wait.then", "NOT_AVAILABLE"),
+        **_nothing("wait.then", "NOT_AVAILABLE"),
     },
 }
 

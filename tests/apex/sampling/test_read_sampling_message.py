@@ -3,7 +3,8 @@
 
 NO_ERROR with VALIDITY = VALID while the message's age is within the refresh period, INVALID
 once it is older; NO_ACTION: the port is empty; INVALID_PARAM: no such sampling port;
-INVALID_MODE: the port is not a destination. Outputs are written only on NO_ERROR.
+INVALID_MODE: the port is not a destination. NO_ACTION sets LENGTH to 0 and VALIDITY to
+INVALID (the message buffer is left alone); the errors leave every output alone.
 """
 
 FRAMES = 3
@@ -18,15 +19,15 @@ def _read(name: str, validity: str, message: str) -> dict:
     }
 
 
-def _refused(name: str, code: str) -> dict:
-    return {name: code, f"{name}.outputs_written": "none"}
+def _refused(name: str, code: str, written: str = "none") -> dict:
+    return {name: code, f"{name}.outputs_written": written}
 
 
 CHECKS = {
     "writer": {},
     "reader": {
         **_read("fresh", "VALID", "msg0"),
-        **_refused("never_written", "NO_ACTION"),
+        **_refused("never_written", "NO_ACTION", "LENGTH=0,VALIDITY=INVALID,"),
         **_refused("id_zero", "INVALID_PARAM"),
         **_refused("id_unknown", "INVALID_PARAM"),
         **_refused("source_port", "INVALID_MODE"),

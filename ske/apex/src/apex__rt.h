@@ -155,11 +155,14 @@ void apex__invalid_address(const void *address);
 
 /* The addresses a caller gives a service (user.c). Every service starts with apex__enter:
  * it brings time up to date and checks RETURN_CODE; false means the service must return at
- * once (the health monitor has the caller's ILLEGAL_REQUEST). The others are false for a null
- * pointer, which a service answers with INVALID_PARAM; an address that cannot be read (or
- * written, for an output) is an ILLEGAL_REQUEST, as when a message copy faults. */
+ * once (the health monitor has the caller's ILLEGAL_REQUEST). The others check an address: a
+ * null one, or one that cannot be read (or written, for an output), is an ILLEGAL_REQUEST, as
+ * when a message copy faults; they return false only if the health monitor let the caller go
+ * on, and the service then answers INVALID_PARAM. */
 bool apex__enter(RETURN_CODE_TYPE *rc);
 bool apex__out_ok(void *p, size_t n);
+/* A message address, checked where it is used (the copy is bracketed by apex__user_copy). */
+bool apex__addr_ok(const void *p);
 bool apex__in_ok(const void *p, size_t n);
 /* A name parameter: readable up to its NUL or MAX_NAME_LENGTH characters. */
 bool apex__name_ok(const char *name);

@@ -70,7 +70,7 @@ void DISPLAY_BLACKBOARD(
     if (!apex__enter(RETURN_CODE))
         return;
     int k = blackboard_index(BLACKBOARD_ID);
-    if (k < 0 || LENGTH > apex__intra.blackboards[k].max_size || LENGTH <= 0 || !MESSAGE_ADDR) {
+    if (k < 0 || LENGTH > apex__intra.blackboards[k].max_size || LENGTH <= 0 || !apex__addr_ok(MESSAGE_ADDR)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -103,7 +103,7 @@ void READ_BLACKBOARD(
         return;
     int k = blackboard_index(BLACKBOARD_ID);
     int64_t until;
-    if (k < 0 || !apex__time_out(TIME_OUT, &until) || !MESSAGE_ADDR ||
+    if (k < 0 || !apex__time_out(TIME_OUT, &until) || !apex__addr_ok(MESSAGE_ADDR) ||
         !apex__out_ok(LENGTH, sizeof *LENGTH)) {
         *RETURN_CODE = INVALID_PARAM;
         return;

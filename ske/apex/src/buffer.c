@@ -105,7 +105,7 @@ void SEND_BUFFER(
         return;
     int k = buffer_index(BUFFER_ID);
     int64_t until;
-    if (k < 0 || LENGTH > apex__intra.buffers[k].max_size || LENGTH <= 0 || !MESSAGE_ADDR ||
+    if (k < 0 || LENGTH > apex__intra.buffers[k].max_size || LENGTH <= 0 || !apex__addr_ok(MESSAGE_ADDR) ||
         !apex__time_out(TIME_OUT, &until)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
@@ -150,7 +150,7 @@ void RECEIVE_BUFFER(
         return;
     int k = buffer_index(BUFFER_ID);
     int64_t until;
-    if (k < 0 || !apex__time_out(TIME_OUT, &until) || !MESSAGE_ADDR ||
+    if (k < 0 || !apex__time_out(TIME_OUT, &until) || !apex__addr_ok(MESSAGE_ADDR) ||
         !apex__out_ok(LENGTH, sizeof *LENGTH)) {
         *RETURN_CODE = INVALID_PARAM;
         return;

@@ -10,7 +10,7 @@ void REPORT_APPLICATION_MESSAGE(
 {
     if (!apex__enter(RETURN_CODE))
         return;
-    if (LENGTH < 0 || LENGTH > MAX_ERROR_MESSAGE_SIZE || (LENGTH > 0 && !MESSAGE_ADDR)) {
+    if (LENGTH < 0 || LENGTH > MAX_ERROR_MESSAGE_SIZE || (LENGTH > 0 && !apex__addr_ok(MESSAGE_ADDR))) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }

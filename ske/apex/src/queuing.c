@@ -182,7 +182,7 @@ void SEND_QUEUING_MESSAGE(
         return;
     }
     int64_t until = INT64_MAX;
-    if (LENGTH <= 0 || !MESSAGE_ADDR || TIME_OUT < INFINITE_TIME_VALUE ||
+    if (LENGTH <= 0 || !apex__addr_ok(MESSAGE_ADDR) || TIME_OUT < INFINITE_TIME_VALUE ||
         (TIME_OUT > 0 && !apex__time_add(apex__now(), TIME_OUT, &until))) {
         *RETURN_CODE = INVALID_PARAM;
         return;
@@ -223,7 +223,7 @@ void RECEIVE_QUEUING_MESSAGE(
 {
     if (!apex__enter(RETURN_CODE))
         return;
-    if (!MESSAGE_ADDR || !apex__out_ok(LENGTH, sizeof *LENGTH)) {
+    if (!apex__addr_ok(MESSAGE_ADDR) || !apex__out_ok(LENGTH, sizeof *LENGTH)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }

@@ -93,7 +93,7 @@ void WRITE_SAMPLING_MESSAGE(
         *RETURN_CODE = INVALID_CONFIG;
         return;
     }
-    if (LENGTH <= 0 || !MESSAGE_ADDR) {
+    if (LENGTH <= 0 || !apex__addr_ok(MESSAGE_ADDR)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -116,7 +116,7 @@ void READ_SAMPLING_MESSAGE(
 {
     if (!apex__enter(RETURN_CODE))
         return;
-    if (!MESSAGE_ADDR || !apex__out_ok(LENGTH, sizeof *LENGTH) ||
+    if (!apex__addr_ok(MESSAGE_ADDR) || !apex__out_ok(LENGTH, sizeof *LENGTH) ||
         !apex__out_ok(VALIDITY, sizeof *VALIDITY)) {
         *RETURN_CODE = INVALID_PARAM;
         return;

@@ -35,7 +35,7 @@ void READ_UPDATED_SAMPLING_MESSAGE(
 {
     if (!apex__enter(RETURN_CODE))
         return;
-    if (!MESSAGE_ADDR || !apex__out_ok(LENGTH, sizeof *LENGTH) ||
+    if (!apex__addr_ok(MESSAGE_ADDR) || !apex__out_ok(LENGTH, sizeof *LENGTH) ||
         !apex__out_ok(UPDATED, sizeof *UPDATED)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
@@ -103,7 +103,7 @@ void READ_SAMPLING_MESSAGE_CONDITIONAL(
 {
     if (!apex__enter(RETURN_CODE))
         return;
-    if (!MESSAGE_ADDR || !apex__out_ok(LENGTH, sizeof *LENGTH) ||
+    if (!apex__addr_ok(MESSAGE_ADDR) || !apex__out_ok(LENGTH, sizeof *LENGTH) ||
         !apex__out_ok(TIME_STAMP, sizeof *TIME_STAMP)) {
         *RETURN_CODE = INVALID_PARAM;
         return;

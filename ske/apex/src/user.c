@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The addresses a partition gives APEX services: a null pointer is an invalid parameter, an
- * address the partition cannot read or write is its ILLEGAL_REQUEST, never a fault of the
- * library (a raw SIGSEGV would be charged to the service as a MEMORY_VIOLATION). */
+/* The addresses a partition gives APEX services: a null pointer, or an address the partition
+ * cannot read or write, is its ILLEGAL_REQUEST, never a fault of the library (a raw SIGSEGV
+ * would be charged to the service as a MEMORY_VIOLATION). */
 #include <string.h>
 
 #include "apex__rt.h"
@@ -40,10 +40,21 @@ bool apex__enter(RETURN_CODE_TYPE *rc)
     return true;
 }
 
+/* A null address takes the path of any other address the caller cannot use: the health
+ * monitor has its ILLEGAL_REQUEST and the call does not go on. The false return is for a
+ * caller the health monitor let go on (an IGNORE of an error its process survives). */
+static bool null_address(void)
+{
+    apex__invalid_address(NULL);
+    return false;
+}
+
+bool apex__addr_ok(const void *p) { return p ? true : null_address(); }
+
 bool apex__out_ok(void *p, size_t n)
 {
     if (!p)
-        return false;
+        return null_address();
     probe(p, n, true);
     return true;
 }
@@ -51,7 +62,7 @@ bool apex__out_ok(void *p, size_t n)
 bool apex__in_ok(const void *p, size_t n)
 {
     if (!p)
-        return false;
+        return null_address();
     probe(p, n, false);
     return true;
 }
@@ -59,7 +70,7 @@ bool apex__in_ok(const void *p, size_t n)
 bool apex__name_ok(const char *name)
 {
     if (!name)
-        return false;
+        return null_address();
     apex__user_copy(true);
     volatile size_t n = strnlen(name, MAX_NAME_LENGTH); /* volatile: the read must happen */
     apex__user_copy(false);

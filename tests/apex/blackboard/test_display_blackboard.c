@@ -90,7 +90,6 @@ int main(void)
     try_display("init.length_over_max", board, big, 9, INVALID_PARAM);
     try_display("init.length_zero", board, big, 0, INVALID_PARAM);
     try_display("init.length_negative", board, big, -1, INVALID_PARAM);
-    try_display("init.null_address", board, NULL, 4, INVALID_PARAM);
     check_str("init.errors.still_empty", "EMPTY",
               empty_indicator_name(status_of(board).EMPTY_INDICATOR));
 

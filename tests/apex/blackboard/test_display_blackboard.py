@@ -2,7 +2,7 @@
 """DISPLAY_BLACKBOARD (ARINC 653 Part 1, 3.7.2.2): every return code the standard lists.
 
 INVALID_PARAM: no such blackboard, LENGTH above its maximum message size, LENGTH null or
-negative (or a null address); NO_ERROR: the message is displayed, replacing the previous one,
+negative; NO_ERROR: the message is displayed, replacing the previous one,
 and every waiting reader gets it.
 """
 
@@ -15,7 +15,6 @@ CHECKS = {
         "init.length_over_max": "INVALID_PARAM",
         "init.length_zero": "INVALID_PARAM",
         "init.length_negative": "INVALID_PARAM",
-        "init.null_address": "INVALID_PARAM",
         "init.errors.still_empty": "EMPTY",
         "init.first": "NO_ERROR",
         "init.first.read": "one/3",

@@ -71,14 +71,8 @@ int main(void)
     try_read("init.id_zero", 0, 0, INVALID_PARAM, "-");
     try_read("init.id_unknown", empty_board + 1, 0, INVALID_PARAM, "-");
     try_read("init.timeout_minus_2", board, -2, INVALID_PARAM, "-");
-    MESSAGE_SIZE_TYPE len;
-    APEX_BYTE msg[16];
-    READ_BLACKBOARD(board, 0, NULL, &len, &rc);
-    check_rc("init.null_address", INVALID_PARAM, rc);
-    READ_BLACKBOARD(board, 0, msg, NULL, &rc);
-    check_rc("init.null_length", INVALID_PARAM, rc);
     try_read("init.empty.no_wait", board, 0, NOT_AVAILABLE, "-");
-    /* The initialisation process cannot wait. */
+    /* (Null addresses: tests/apex/pointers/.) The initialisation process cannot wait. */
     try_read("init.empty.would_wait", board, 1 * MS, INVALID_MODE, "-");
     try_read("init.empty.would_wait_forever", board, INFINITE_TIME_VALUE, INVALID_MODE, "-");
     DISPLAY_BLACKBOARD(board, (MESSAGE_ADDR_TYPE) "hello", 5, &rc);

@@ -2,7 +2,7 @@
 """READ_BLACKBOARD (ARINC 653 Part 1, 3.7.2.2): every return code the standard lists.
 
 INVALID_PARAM: no such blackboard, TIME_OUT out of range (below -1, or ending past the end of
-the clock), or a null address or LENGTH; NOT_AVAILABLE: the blackboard is empty and TIME_OUT
+the clock); NOT_AVAILABLE: the blackboard is empty and TIME_OUT
 is 0; INVALID_MODE: the caller would have to wait and may not (preemption locked, the error
 handler, here also the initialisation process); TIMED_OUT: still empty when the time-out
 expires; NO_ERROR: the displayed message and its LENGTH, at once or when it is displayed.
@@ -28,8 +28,6 @@ CHECKS = {
         **read("init.id_zero", "INVALID_PARAM"),
         **read("init.id_unknown", "INVALID_PARAM"),
         **read("init.timeout_minus_2", "INVALID_PARAM"),
-        "init.null_address": "INVALID_PARAM",
-        "init.null_length": "INVALID_PARAM",
         **nothing("init.empty.no_wait", "NOT_AVAILABLE"),
         **nothing("init.empty.would_wait", "INVALID_MODE"),
         **nothing("init.empty.would_wait_forever", "INVALID_MODE"),

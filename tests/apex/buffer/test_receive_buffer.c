@@ -121,14 +121,8 @@ int main(void)
     try_receive("init.id_zero", 0, 0, INVALID_PARAM, "-");
     try_receive("init.id_unknown", rp + 1, 0, INVALID_PARAM, "-");
     try_receive("init.timeout_minus_2", rf, -2, INVALID_PARAM, "-");
-    MESSAGE_SIZE_TYPE len;
-    APEX_BYTE msg[8];
-    RECEIVE_BUFFER(rf, 0, NULL, &len, &rc);
-    check_rc("init.null_address", INVALID_PARAM, rc);
-    RECEIVE_BUFFER(rf, 0, msg, NULL, &rc);
-    check_rc("init.null_length", INVALID_PARAM, rc);
     try_receive("init.empty.no_wait", rf, 0, NOT_AVAILABLE, "-");
-    /* The initialisation process cannot wait. */
+    /* (Null addresses: tests/apex/pointers/.) The initialisation process cannot wait. */
     try_receive("init.empty.would_wait", rf, 1 * MS, INVALID_MODE, "-");
     send_text(rf, "m1");
     try_receive("init.message", rf, INFINITE_TIME_VALUE, NO_ERROR, "m1");

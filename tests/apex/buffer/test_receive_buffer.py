@@ -2,7 +2,7 @@
 """RECEIVE_BUFFER (ARINC 653 Part 1, 3.7.2.1): every return code the standard lists.
 
 INVALID_PARAM: no such buffer, TIME_OUT out of range (below -1, or ending past the end of the
-clock), or a null address or LENGTH; NOT_AVAILABLE: the buffer is empty and TIME_OUT is 0;
+clock); NOT_AVAILABLE: the buffer is empty and TIME_OUT is 0;
 INVALID_MODE: the caller would have to wait and may not (preemption locked, the error
 handler, here also the initialisation process); TIMED_OUT: still empty when the time-out
 expires; NO_ERROR: the oldest message and its LENGTH, at once or after waiting. When no
@@ -28,8 +28,6 @@ CHECKS = {
         **receive("init.id_zero", "INVALID_PARAM"),
         **receive("init.id_unknown", "INVALID_PARAM"),
         **receive("init.timeout_minus_2", "INVALID_PARAM"),
-        "init.null_address": "INVALID_PARAM",
-        "init.null_length": "INVALID_PARAM",
         **nothing("init.empty.no_wait", "NOT_AVAILABLE"),
         **nothing("init.empty.would_wait", "INVALID_MODE"),
         **receive("init.message", "NO_ERROR", "m1", 2),

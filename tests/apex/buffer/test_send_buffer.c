@@ -146,7 +146,6 @@ int main(void)
     try_send("init.length_over_max", bf, big, 9, 0, INVALID_PARAM);
     try_send("init.length_zero", bf, big, 0, 0, INVALID_PARAM);
     try_send("init.length_negative", bf, big, -1, 0, INVALID_PARAM);
-    try_send("init.null_address", bf, NULL, 4, 0, INVALID_PARAM);
     try_send("init.timeout_minus_2", bf, big, 4, -2, INVALID_PARAM);
 
     check_rc("init.send.0", NO_ERROR, send_text(bf, "i0", 0));

@@ -2,7 +2,7 @@
 """SEND_BUFFER (ARINC 653 Part 1, 3.7.2.1): every return code the standard lists.
 
 INVALID_PARAM: no such buffer, LENGTH above its maximum message size, LENGTH null or
-negative (or a null address), TIME_OUT out of range (below -1, or ending past the end of the
+negative, TIME_OUT out of range (below -1, or ending past the end of the
 clock); NOT_AVAILABLE: the buffer is full and TIME_OUT is 0; INVALID_MODE: the caller would
 have to wait and may not (preemption locked, the error handler, here also the initialisation
 process); TIMED_OUT: still full when the time-out expires; NO_ERROR: the message is in the
@@ -18,7 +18,6 @@ CHECKS = {
         "init.length_over_max": "INVALID_PARAM",
         "init.length_zero": "INVALID_PARAM",
         "init.length_negative": "INVALID_PARAM",
-        "init.null_address": "INVALID_PARAM",
         "init.timeout_minus_2": "INVALID_PARAM",
         "init.send.0": "NO_ERROR",
         "init.send.1": "NO_ERROR",

@@ -1,10 +1,10 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Null and invalid addresses given to APEX services, table-driven. Partition "nulls": every
- * pointer parameter of every service, null in turn (all others valid), returns INVALID_PARAM
- * and writes nothing (the few documented exceptions say otherwise). Partition "faults": a
- * null RETURN_CODE for every service, and unreadable or unwritable addresses for some, are the
- * caller's ILLEGAL_REQUEST for the health monitor (here handled at process level by the error
- * handler), never a MEMORY_VIOLATION of the library. */
+/* Null and invalid addresses given to APEX services, table-driven. Partition "faults": every
+ * pointer parameter of every service null in turn (all others valid), a null RETURN_CODE for
+ * every service, and unreadable or unwritable addresses for some are the caller's
+ * ILLEGAL_REQUEST for the health monitor (here handled at process level by the error handler),
+ * with no output written, never a MEMORY_VIOLATION of the library. Partition "nulls": the few
+ * documented exceptions, where a null is not an address the service uses, return their code. */
 #include "apex_check.h"
 
 static SAMPLING_PORT_ID_TYPE sp_src, sp_dst;
@@ -28,113 +28,119 @@ static APEX_INTEGER id_out;
 static void worker(void) {}
 static void handler(void);
 
-/* ---- null pointers other than RETURN_CODE: INVALID_PARAM -------------------------------- */
+/* ---- null pointers ----------------------------------------------------------------------- */
 
-/* X(check name, expected return code, the call with rc as its RETURN_CODE). */
+/* A null pointer is an address the service cannot use: the caller's ILLEGAL_REQUEST for the
+ * health monitor, as an unusable address is (run by the victim of partition "faults"). */
+#define ILLEGAL ((RETURN_CODE_TYPE)-1)
+
+/* X(check name, expected return code or ILLEGAL, the call with rc as its RETURN_CODE). The
+ * return codes are the documented exceptions, where the null is not an address the service
+ * uses: a message of length 0 is not read; an entry point is a value, checked as such. */
 #define NULL_CASES(X)                                                                          \
-    X(GET_PARTITION_STATUS__PARTITION_STATUS, INVALID_PARAM, GET_PARTITION_STATUS(NULL, &rc))  \
-    X(CREATE_PROCESS__ATTRIBUTES, INVALID_PARAM, CREATE_PROCESS(NULL, &id_out, &rc))          \
-    X(CREATE_PROCESS__PROCESS_ID, INVALID_PARAM, CREATE_PROCESS(&attr, NULL, &rc))            \
+    X(GET_PARTITION_STATUS__PARTITION_STATUS, ILLEGAL, GET_PARTITION_STATUS(NULL, &rc))  \
+    X(CREATE_PROCESS__ATTRIBUTES, ILLEGAL, CREATE_PROCESS(NULL, &id_out, &rc))          \
+    X(CREATE_PROCESS__PROCESS_ID, ILLEGAL, CREATE_PROCESS(&attr, NULL, &rc))            \
     X(CREATE_PROCESS__ENTRY_POINT, INVALID_PARAM, CREATE_PROCESS(&attr_no_entry, &id_out, &rc)) \
-    X(LOCK_PREEMPTION__LOCK_LEVEL, INVALID_PARAM, LOCK_PREEMPTION(NULL, &rc))                 \
-    X(UNLOCK_PREEMPTION__LOCK_LEVEL, INVALID_PARAM, UNLOCK_PREEMPTION(NULL, &rc))             \
-    X(GET_MY_ID__PROCESS_ID, INVALID_PARAM, GET_MY_ID(NULL, &rc))                             \
-    X(GET_PROCESS_ID__PROCESS_NAME, INVALID_PARAM, GET_PROCESS_ID(NULL, &id_out, &rc))        \
-    X(GET_PROCESS_ID__PROCESS_ID, INVALID_PARAM, GET_PROCESS_ID("worker", NULL, &rc))         \
-    X(GET_PROCESS_STATUS__PROCESS_STATUS, INVALID_PARAM, GET_PROCESS_STATUS(proc_id, NULL, &rc)) \
-    X(GET_TIME__SYSTEM_TIME, INVALID_PARAM, GET_TIME(NULL, &rc))                              \
-    X(CREATE_SAMPLING_PORT__SAMPLING_PORT_NAME, INVALID_PARAM,                                 \
+    X(LOCK_PREEMPTION__LOCK_LEVEL, ILLEGAL, LOCK_PREEMPTION(NULL, &rc))                 \
+    X(UNLOCK_PREEMPTION__LOCK_LEVEL, ILLEGAL, UNLOCK_PREEMPTION(NULL, &rc))             \
+    X(GET_MY_ID__PROCESS_ID, ILLEGAL, GET_MY_ID(NULL, &rc))                             \
+    X(GET_PROCESS_ID__PROCESS_NAME, ILLEGAL, GET_PROCESS_ID(NULL, &id_out, &rc))        \
+    X(GET_PROCESS_ID__PROCESS_ID, ILLEGAL, GET_PROCESS_ID("worker", NULL, &rc))         \
+    X(GET_PROCESS_STATUS__PROCESS_STATUS, ILLEGAL, GET_PROCESS_STATUS(proc_id, NULL, &rc)) \
+    X(GET_TIME__SYSTEM_TIME, ILLEGAL, GET_TIME(NULL, &rc))                              \
+    X(CREATE_SAMPLING_PORT__SAMPLING_PORT_NAME, ILLEGAL,                                 \
       CREATE_SAMPLING_PORT(NULL, 16, SOURCE, 20 * MS, &id_out, &rc))                           \
-    X(CREATE_SAMPLING_PORT__SAMPLING_PORT_ID, INVALID_PARAM,                                   \
+    X(CREATE_SAMPLING_PORT__SAMPLING_PORT_ID, ILLEGAL,                                   \
       CREATE_SAMPLING_PORT("SP_UNUSED", 16, SOURCE, 20 * MS, NULL, &rc))                       \
-    X(WRITE_SAMPLING_MESSAGE__MESSAGE_ADDR, INVALID_PARAM,                                     \
+    X(WRITE_SAMPLING_MESSAGE__MESSAGE_ADDR, ILLEGAL,                                     \
       WRITE_SAMPLING_MESSAGE(sp_src, NULL, 4, &rc))                                            \
-    X(READ_SAMPLING_MESSAGE__MESSAGE_ADDR, INVALID_PARAM,                                      \
+    X(READ_SAMPLING_MESSAGE__MESSAGE_ADDR, ILLEGAL,                                      \
       READ_SAMPLING_MESSAGE(sp_dst, NULL, &len, &validity, &rc))                               \
-    X(READ_SAMPLING_MESSAGE__LENGTH, INVALID_PARAM,                                            \
+    X(READ_SAMPLING_MESSAGE__LENGTH, ILLEGAL,                                            \
       READ_SAMPLING_MESSAGE(sp_dst, msg, NULL, &validity, &rc))                                \
-    X(READ_SAMPLING_MESSAGE__VALIDITY, INVALID_PARAM,                                          \
+    X(READ_SAMPLING_MESSAGE__VALIDITY, ILLEGAL,                                          \
       READ_SAMPLING_MESSAGE(sp_dst, msg, &len, NULL, &rc))                                     \
-    X(GET_SAMPLING_PORT_ID__SAMPLING_PORT_NAME, INVALID_PARAM,                                 \
+    X(GET_SAMPLING_PORT_ID__SAMPLING_PORT_NAME, ILLEGAL,                                 \
       GET_SAMPLING_PORT_ID(NULL, &id_out, &rc))                                                \
-    X(GET_SAMPLING_PORT_ID__SAMPLING_PORT_ID, INVALID_PARAM,                                   \
+    X(GET_SAMPLING_PORT_ID__SAMPLING_PORT_ID, ILLEGAL,                                   \
       GET_SAMPLING_PORT_ID("SP_SRC", NULL, &rc))                                               \
-    X(GET_SAMPLING_PORT_STATUS__SAMPLING_PORT_STATUS, INVALID_PARAM,                           \
+    X(GET_SAMPLING_PORT_STATUS__SAMPLING_PORT_STATUS, ILLEGAL,                           \
       GET_SAMPLING_PORT_STATUS(sp_src, NULL, &rc))                                             \
-    X(READ_UPDATED_SAMPLING_MESSAGE__MESSAGE_ADDR, INVALID_PARAM,                              \
+    X(READ_UPDATED_SAMPLING_MESSAGE__MESSAGE_ADDR, ILLEGAL,                              \
       READ_UPDATED_SAMPLING_MESSAGE(sp_dst, NULL, &len, &updated, &rc))                        \
-    X(READ_UPDATED_SAMPLING_MESSAGE__LENGTH, INVALID_PARAM,                                    \
+    X(READ_UPDATED_SAMPLING_MESSAGE__LENGTH, ILLEGAL,                                    \
       READ_UPDATED_SAMPLING_MESSAGE(sp_dst, msg, NULL, &updated, &rc))                         \
-    X(READ_UPDATED_SAMPLING_MESSAGE__UPDATED, INVALID_PARAM,                                   \
+    X(READ_UPDATED_SAMPLING_MESSAGE__UPDATED, ILLEGAL,                                   \
       READ_UPDATED_SAMPLING_MESSAGE(sp_dst, msg, &len, NULL, &rc))                             \
-    X(GET_SAMPLING_PORT_CURRENT_STATUS__SAMPLING_PORT_CURRENT_STATUS, INVALID_PARAM,           \
+    X(GET_SAMPLING_PORT_CURRENT_STATUS__SAMPLING_PORT_CURRENT_STATUS, ILLEGAL,           \
       GET_SAMPLING_PORT_CURRENT_STATUS(sp_dst, NULL, &rc))                                     \
-    X(READ_SAMPLING_MESSAGE_CONDITIONAL__MESSAGE_ADDR, INVALID_PARAM,                          \
+    X(READ_SAMPLING_MESSAGE_CONDITIONAL__MESSAGE_ADDR, ILLEGAL,                          \
       READ_SAMPLING_MESSAGE_CONDITIONAL(sp_dst, 0, NULL, &len, &t, &rc))                       \
-    X(READ_SAMPLING_MESSAGE_CONDITIONAL__LENGTH, INVALID_PARAM,                                \
+    X(READ_SAMPLING_MESSAGE_CONDITIONAL__LENGTH, ILLEGAL,                                \
       READ_SAMPLING_MESSAGE_CONDITIONAL(sp_dst, 0, msg, NULL, &t, &rc))                        \
-    X(READ_SAMPLING_MESSAGE_CONDITIONAL__TIME_STAMP, INVALID_PARAM,                            \
+    X(READ_SAMPLING_MESSAGE_CONDITIONAL__TIME_STAMP, ILLEGAL,                            \
       READ_SAMPLING_MESSAGE_CONDITIONAL(sp_dst, 0, msg, &len, NULL, &rc))                      \
-    X(CREATE_QUEUING_PORT__QUEUING_PORT_NAME, INVALID_PARAM,                                   \
+    X(CREATE_QUEUING_PORT__QUEUING_PORT_NAME, ILLEGAL,                                   \
       CREATE_QUEUING_PORT(NULL, 16, 4, SOURCE, FIFO, &id_out, &rc))                            \
-    X(CREATE_QUEUING_PORT__QUEUING_PORT_ID, INVALID_PARAM,                                     \
+    X(CREATE_QUEUING_PORT__QUEUING_PORT_ID, ILLEGAL,                                     \
       CREATE_QUEUING_PORT("QP_UNUSED", 16, 4, SOURCE, FIFO, NULL, &rc))                        \
-    X(SEND_QUEUING_MESSAGE__MESSAGE_ADDR, INVALID_PARAM,                                       \
+    X(SEND_QUEUING_MESSAGE__MESSAGE_ADDR, ILLEGAL,                                       \
       SEND_QUEUING_MESSAGE(qp_src, NULL, 4, 0, &rc))                                           \
-    X(RECEIVE_QUEUING_MESSAGE__MESSAGE_ADDR, INVALID_PARAM,                                    \
+    X(RECEIVE_QUEUING_MESSAGE__MESSAGE_ADDR, ILLEGAL,                                    \
       RECEIVE_QUEUING_MESSAGE(qp_dst, 0, NULL, &len, &rc))                                     \
-    X(RECEIVE_QUEUING_MESSAGE__LENGTH, INVALID_PARAM,                                          \
+    X(RECEIVE_QUEUING_MESSAGE__LENGTH, ILLEGAL,                                          \
       RECEIVE_QUEUING_MESSAGE(qp_dst, 0, msg, NULL, &rc))                                      \
-    X(GET_QUEUING_PORT_ID__QUEUING_PORT_NAME, INVALID_PARAM,                                   \
+    X(GET_QUEUING_PORT_ID__QUEUING_PORT_NAME, ILLEGAL,                                   \
       GET_QUEUING_PORT_ID(NULL, &id_out, &rc))                                                 \
-    X(GET_QUEUING_PORT_ID__QUEUING_PORT_ID, INVALID_PARAM,                                     \
+    X(GET_QUEUING_PORT_ID__QUEUING_PORT_ID, ILLEGAL,                                     \
       GET_QUEUING_PORT_ID("QP_SRC", NULL, &rc))                                                \
-    X(GET_QUEUING_PORT_STATUS__QUEUING_PORT_STATUS, INVALID_PARAM,                             \
+    X(GET_QUEUING_PORT_STATUS__QUEUING_PORT_STATUS, ILLEGAL,                             \
       GET_QUEUING_PORT_STATUS(qp_src, NULL, &rc))                                              \
-    X(CREATE_BUFFER__BUFFER_NAME, INVALID_PARAM, CREATE_BUFFER(NULL, 16, 4, FIFO, &id_out, &rc)) \
-    X(CREATE_BUFFER__BUFFER_ID, INVALID_PARAM, CREATE_BUFFER("B2", 16, 4, FIFO, NULL, &rc))   \
-    X(SEND_BUFFER__MESSAGE_ADDR, INVALID_PARAM, SEND_BUFFER(buf_id, NULL, 4, 0, &rc))         \
-    X(RECEIVE_BUFFER__MESSAGE_ADDR, INVALID_PARAM, RECEIVE_BUFFER(buf_id, 0, NULL, &len, &rc)) \
-    X(RECEIVE_BUFFER__LENGTH, INVALID_PARAM, RECEIVE_BUFFER(buf_id, 0, msg, NULL, &rc))       \
-    X(GET_BUFFER_ID__BUFFER_NAME, INVALID_PARAM, GET_BUFFER_ID(NULL, &id_out, &rc))           \
-    X(GET_BUFFER_ID__BUFFER_ID, INVALID_PARAM, GET_BUFFER_ID("BUF", NULL, &rc))               \
-    X(GET_BUFFER_STATUS__BUFFER_STATUS, INVALID_PARAM, GET_BUFFER_STATUS(buf_id, NULL, &rc))  \
-    X(CREATE_BLACKBOARD__BLACKBOARD_NAME, INVALID_PARAM,                                       \
+    X(CREATE_BUFFER__BUFFER_NAME, ILLEGAL, CREATE_BUFFER(NULL, 16, 4, FIFO, &id_out, &rc)) \
+    X(CREATE_BUFFER__BUFFER_ID, ILLEGAL, CREATE_BUFFER("B2", 16, 4, FIFO, NULL, &rc))   \
+    X(SEND_BUFFER__MESSAGE_ADDR, ILLEGAL, SEND_BUFFER(buf_id, NULL, 4, 0, &rc))         \
+    X(RECEIVE_BUFFER__MESSAGE_ADDR, ILLEGAL, RECEIVE_BUFFER(buf_id, 0, NULL, &len, &rc)) \
+    X(RECEIVE_BUFFER__LENGTH, ILLEGAL, RECEIVE_BUFFER(buf_id, 0, msg, NULL, &rc))       \
+    X(GET_BUFFER_ID__BUFFER_NAME, ILLEGAL, GET_BUFFER_ID(NULL, &id_out, &rc))           \
+    X(GET_BUFFER_ID__BUFFER_ID, ILLEGAL, GET_BUFFER_ID("BUF", NULL, &rc))               \
+    X(GET_BUFFER_STATUS__BUFFER_STATUS, ILLEGAL, GET_BUFFER_STATUS(buf_id, NULL, &rc))  \
+    X(CREATE_BLACKBOARD__BLACKBOARD_NAME, ILLEGAL,                                       \
       CREATE_BLACKBOARD(NULL, 16, &id_out, &rc))                                               \
-    X(CREATE_BLACKBOARD__BLACKBOARD_ID, INVALID_PARAM, CREATE_BLACKBOARD("BB2", 16, NULL, &rc)) \
-    X(DISPLAY_BLACKBOARD__MESSAGE_ADDR, INVALID_PARAM, DISPLAY_BLACKBOARD(bb_id, NULL, 4, &rc)) \
-    X(READ_BLACKBOARD__MESSAGE_ADDR, INVALID_PARAM, READ_BLACKBOARD(bb_id, 0, NULL, &len, &rc)) \
-    X(READ_BLACKBOARD__LENGTH, INVALID_PARAM, READ_BLACKBOARD(bb_id, 0, msg, NULL, &rc))      \
-    X(GET_BLACKBOARD_ID__BLACKBOARD_NAME, INVALID_PARAM, GET_BLACKBOARD_ID(NULL, &id_out, &rc)) \
-    X(GET_BLACKBOARD_ID__BLACKBOARD_ID, INVALID_PARAM, GET_BLACKBOARD_ID("BB", NULL, &rc))    \
-    X(GET_BLACKBOARD_STATUS__BLACKBOARD_STATUS, INVALID_PARAM,                                 \
+    X(CREATE_BLACKBOARD__BLACKBOARD_ID, ILLEGAL, CREATE_BLACKBOARD("BB2", 16, NULL, &rc)) \
+    X(DISPLAY_BLACKBOARD__MESSAGE_ADDR, ILLEGAL, DISPLAY_BLACKBOARD(bb_id, NULL, 4, &rc)) \
+    X(READ_BLACKBOARD__MESSAGE_ADDR, ILLEGAL, READ_BLACKBOARD(bb_id, 0, NULL, &len, &rc)) \
+    X(READ_BLACKBOARD__LENGTH, ILLEGAL, READ_BLACKBOARD(bb_id, 0, msg, NULL, &rc))      \
+    X(GET_BLACKBOARD_ID__BLACKBOARD_NAME, ILLEGAL, GET_BLACKBOARD_ID(NULL, &id_out, &rc)) \
+    X(GET_BLACKBOARD_ID__BLACKBOARD_ID, ILLEGAL, GET_BLACKBOARD_ID("BB", NULL, &rc))    \
+    X(GET_BLACKBOARD_STATUS__BLACKBOARD_STATUS, ILLEGAL,                                 \
       GET_BLACKBOARD_STATUS(bb_id, NULL, &rc))                                                 \
-    X(CREATE_SEMAPHORE__SEMAPHORE_NAME, INVALID_PARAM,                                         \
+    X(CREATE_SEMAPHORE__SEMAPHORE_NAME, ILLEGAL,                                         \
       CREATE_SEMAPHORE(NULL, 0, 1, FIFO, &id_out, &rc))                                        \
-    X(CREATE_SEMAPHORE__SEMAPHORE_ID, INVALID_PARAM,                                           \
+    X(CREATE_SEMAPHORE__SEMAPHORE_ID, ILLEGAL,                                           \
       CREATE_SEMAPHORE("S2", 0, 1, FIFO, NULL, &rc))                                           \
-    X(GET_SEMAPHORE_ID__SEMAPHORE_NAME, INVALID_PARAM, GET_SEMAPHORE_ID(NULL, &id_out, &rc))  \
-    X(GET_SEMAPHORE_ID__SEMAPHORE_ID, INVALID_PARAM, GET_SEMAPHORE_ID("SEM", NULL, &rc))      \
-    X(GET_SEMAPHORE_STATUS__SEMAPHORE_STATUS, INVALID_PARAM,                                   \
+    X(GET_SEMAPHORE_ID__SEMAPHORE_NAME, ILLEGAL, GET_SEMAPHORE_ID(NULL, &id_out, &rc))  \
+    X(GET_SEMAPHORE_ID__SEMAPHORE_ID, ILLEGAL, GET_SEMAPHORE_ID("SEM", NULL, &rc))      \
+    X(GET_SEMAPHORE_STATUS__SEMAPHORE_STATUS, ILLEGAL,                                   \
       GET_SEMAPHORE_STATUS(sem_id, NULL, &rc))                                                 \
-    X(CREATE_EVENT__EVENT_NAME, INVALID_PARAM, CREATE_EVENT(NULL, &id_out, &rc))              \
-    X(CREATE_EVENT__EVENT_ID, INVALID_PARAM, CREATE_EVENT("E2", NULL, &rc))                   \
-    X(GET_EVENT_ID__EVENT_NAME, INVALID_PARAM, GET_EVENT_ID(NULL, &id_out, &rc))              \
-    X(GET_EVENT_ID__EVENT_ID, INVALID_PARAM, GET_EVENT_ID("EVT", NULL, &rc))                  \
-    X(GET_EVENT_STATUS__EVENT_STATUS, INVALID_PARAM, GET_EVENT_STATUS(evt_id, NULL, &rc))     \
-    X(REPORT_APPLICATION_MESSAGE__MESSAGE_ADDR, INVALID_PARAM,                                 \
+    X(CREATE_EVENT__EVENT_NAME, ILLEGAL, CREATE_EVENT(NULL, &id_out, &rc))              \
+    X(CREATE_EVENT__EVENT_ID, ILLEGAL, CREATE_EVENT("E2", NULL, &rc))                   \
+    X(GET_EVENT_ID__EVENT_NAME, ILLEGAL, GET_EVENT_ID(NULL, &id_out, &rc))              \
+    X(GET_EVENT_ID__EVENT_ID, ILLEGAL, GET_EVENT_ID("EVT", NULL, &rc))                  \
+    X(GET_EVENT_STATUS__EVENT_STATUS, ILLEGAL, GET_EVENT_STATUS(evt_id, NULL, &rc))     \
+    X(REPORT_APPLICATION_MESSAGE__MESSAGE_ADDR, ILLEGAL,                                 \
       REPORT_APPLICATION_MESSAGE(NULL, 4, &rc))                                                \
     X(REPORT_APPLICATION_MESSAGE__MESSAGE_ADDR_LENGTH_0, NO_ERROR,                             \
       REPORT_APPLICATION_MESSAGE(NULL, 0, &rc))                                                \
     X(CREATE_ERROR_HANDLER__ENTRY_POINT, INVALID_CONFIG, CREATE_ERROR_HANDLER(NULL, 65536, &rc)) \
-    X(GET_ERROR_STATUS__ERROR_STATUS, INVALID_PARAM, GET_ERROR_STATUS(NULL, &rc))             \
-    X(RAISE_APPLICATION_ERROR__MESSAGE_ADDR, INVALID_PARAM,                                    \
+    X(GET_ERROR_STATUS__ERROR_STATUS, ILLEGAL, GET_ERROR_STATUS(NULL, &rc))             \
+    X(RAISE_APPLICATION_ERROR__MESSAGE_ADDR, ILLEGAL,                                    \
       RAISE_APPLICATION_ERROR(APPLICATION_ERROR, NULL, 4, &rc))                                \
-    X(GET_MODULE_SCHEDULE_STATUS__SCHEDULE_STATUS, INVALID_PARAM,                              \
+    X(GET_MODULE_SCHEDULE_STATUS__SCHEDULE_STATUS, ILLEGAL,                              \
       GET_MODULE_SCHEDULE_STATUS(NULL, &rc))                                                   \
-    X(GET_MODULE_SCHEDULE_ID__SCHEDULE_NAME, INVALID_PARAM,                                    \
+    X(GET_MODULE_SCHEDULE_ID__SCHEDULE_NAME, ILLEGAL,                                    \
       GET_MODULE_SCHEDULE_ID(NULL, &id_out, &rc))                                              \
-    X(GET_MODULE_SCHEDULE_ID__SCHEDULE_ID, INVALID_PARAM, GET_MODULE_SCHEDULE_ID("main", NULL, &rc))
+    X(GET_MODULE_SCHEDULE_ID__SCHEDULE_ID, ILLEGAL, GET_MODULE_SCHEDULE_ID("main", NULL, &rc))
 
 #define DEFINE_CALL(name, expect, call)                                                        \
     static RETURN_CODE_TYPE name(void)                                                         \
@@ -175,15 +181,25 @@ static bool outputs_untouched(void)
            id_out == UNTOUCHED && strcmp((const char *)msg, "hello") == 0;
 }
 
-static void run_null_cases(void)
+#define N_NULLS (sizeof null_cases / sizeof null_cases[0])
+
+static void reset_outputs(void)
 {
-    for (size_t i = 0; i < sizeof null_cases / sizeof null_cases[0]; i++) {
-        len = UNTOUCHED;
-        validity = (VALIDITY_TYPE)UNTOUCHED;
-        updated = (UPDATED_TYPE)UNTOUCHED;
-        t = UNTOUCHED;
-        level = UNTOUCHED;
-        id_out = UNTOUCHED;
+    len = UNTOUCHED;
+    validity = (VALIDITY_TYPE)UNTOUCHED;
+    updated = (UPDATED_TYPE)UNTOUCHED;
+    t = UNTOUCHED;
+    level = UNTOUCHED;
+    id_out = UNTOUCHED;
+}
+
+/* The exceptions, which return: their return code, and no output written. */
+static void run_null_exceptions(void)
+{
+    for (size_t i = 0; i < N_NULLS; i++) {
+        if (null_cases[i].expect == ILLEGAL)
+            continue;
+        reset_outputs();
         RETURN_CODE_TYPE rc = null_cases[i].call();
         check_rc(check_name("", null_cases[i].name), null_cases[i].expect, rc);
         check_true(check_name("untouched.", null_cases[i].name), outputs_untouched());
@@ -292,8 +308,19 @@ static SCHEDULE_STATUS_TYPE schedule_status;
 static const char *const fault_names[] = {FAULT_CASES(FAULT_ROW)};
 #define N_FAULTS (sizeof fault_names / sizeof fault_names[0])
 
+/* The victim's cases: the fault cases, then the null pointers that are ILLEGAL_REQUESTs. */
+static size_t illegal_nulls[N_NULLS];
+static size_t n_illegal_nulls;
 static size_t fault_case;
 static PROCESS_ID_TYPE victim_id;
+
+/* The check name of case i: "rc_null.SERVICE" / "bad.*" or "null.SERVICE.PARAMETER". */
+static const char *case_name(size_t i)
+{
+    if (i < N_FAULTS)
+        return check_name("rc_null.", fault_names[i]);
+    return check_name("null.", null_cases[illegal_nulls[i - N_FAULTS]].name);
+}
 
 static void run_fault_case(size_t i)
 {
@@ -311,8 +338,12 @@ static void run_fault_case(size_t i)
 /* Runs one case; it should never come back from the call. */
 static void victim(void)
 {
-    run_fault_case(fault_case);
-    check_str(check_name("rc_null.", fault_names[fault_case]), "ILLEGAL_REQUEST", "returned");
+    reset_outputs();
+    if (fault_case < N_FAULTS)
+        run_fault_case(fault_case);
+    else
+        (void)null_cases[illegal_nulls[fault_case - N_FAULTS]].call();
+    check_str(case_name(fault_case), "ILLEGAL_REQUEST", "returned");
 }
 
 static const char *error_name(ERROR_CODE_TYPE e)
@@ -334,7 +365,10 @@ static void handler(void)
         const char *got = error_status.FAILED_PROCESS_ID == victim_id
                               ? error_name(error_status.ERROR_CODE)
                               : "another_process";
-        check_str(check_name("rc_null.", fault_names[fault_case]), "ILLEGAL_REQUEST", got);
+        check_str(case_name(fault_case), "ILLEGAL_REQUEST", got);
+        if (fault_case >= N_FAULTS)
+            check_true(check_name("untouched.", null_cases[illegal_nulls[fault_case - N_FAULTS]].name),
+                       outputs_untouched());
         if (fault_case == 0) {
             static const char expected[] = "APEX service given an invalid address ((nil))";
             check_true("rc_null.message", error_status.LENGTH == (int)strlen(expected) &&
@@ -350,15 +384,16 @@ static void driver(void)
 {
     for (;;) {
         RETURN_CODE_TYPE rc;
-        for (int n = 0; n < 8 && fault_case < N_FAULTS; n++) {
+        size_t cases = N_FAULTS + n_illegal_nulls;
+        for (int n = 0; n < 8 && fault_case < cases; n++) {
             START(victim_id, &rc); /* the victim preempts the driver at once */
             setup_rc("START victim", rc);
             fault_case++;
         }
-        if (fault_case == N_FAULTS)
-            check_int("rc_null.cases_run", (long long)N_FAULTS, (long long)fault_case);
+        if (fault_case == cases)
+            check_int("rc_null.cases_run", (long long)cases, (long long)fault_case);
         PERIODIC_WAIT(&rc);
-        if (fault_case == N_FAULTS)
+        if (fault_case == cases)
             STOP_SELF();
     }
 }
@@ -394,8 +429,11 @@ int main(int argc, char **argv)
 {
     const char *scenario = argc > 1 ? argv[1] : "";
     create_objects();
+    for (size_t i = 0; i < N_NULLS; i++)
+        if (null_cases[i].expect == ILLEGAL)
+            illegal_nulls[n_illegal_nulls++] = i;
     if (strcmp(scenario, "nulls") == 0) {
-        run_null_cases();
+        run_null_exceptions();
     } else if (strcmp(scenario, "faults") == 0) {
         RETURN_CODE_TYPE rc;
         CREATE_ERROR_HANDLER((SYSTEM_ADDRESS_TYPE)handler, 65536, &rc);

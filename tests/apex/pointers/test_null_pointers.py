@@ -1,27 +1,30 @@
 # SPDX-License-Identifier: Apache-2.0
 """Null and invalid addresses given to APEX services: never a raw SIGSEGV.
 
-"nulls": each pointer parameter the APEX headers declare (RETURN_CODE aside), null in turn,
-returns INVALID_PARAM and writes no output. Documented exceptions: REPORT_APPLICATION_MESSAGE
-with LENGTH 0 reads nothing, so a null address is accepted; CREATE_ERROR_HANDLER answers a null
-ENTRY_POINT with INVALID_CONFIG, as the standard's "entry point" check does.
+"faults": each pointer parameter the APEX headers declare, null in turn, a null RETURN_CODE
+and addresses the partition cannot read or write are the caller's ILLEGAL_REQUEST for the
+health monitor, as an invalid message address always was, and write no output; here the
+module handles it at process level, so the error handler sees each one and the victim process
+only stops.
 
-"faults": a null RETURN_CODE (the service cannot say anything) and addresses the partition
-cannot read or write are the caller's ILLEGAL_REQUEST for the health monitor, as an invalid
-message address always was; here the module handles it at process level, so the error
-handler sees each one and the victim process only stops.
+"nulls": the documented exceptions, where a null is not an address the service uses:
+REPORT_APPLICATION_MESSAGE with LENGTH 0 reads nothing, so a null address is accepted;
+CREATE_ERROR_HANDLER answers a null ENTRY_POINT with INVALID_CONFIG, as the standard's "entry
+point" check does; CREATE_PROCESS a null ENTRY_POINT field of its attributes with
+INVALID_PARAM.
 """
 
 import re
 
 from ima import apex_coverage
 
-FRAMES = 12
+FRAMES = 24
 
-# Where a null pointer is not INVALID_PARAM (docs/apex-coverage.md).
+# Where a null pointer is not the caller's ILLEGAL_REQUEST (docs/apex-coverage.md).
 NULL_EXCEPTIONS = {
     "CREATE_ERROR_HANDLER.ENTRY_POINT": "INVALID_CONFIG",
     "REPORT_APPLICATION_MESSAGE.MESSAGE_ADDR_LENGTH_0": "NO_ERROR",
+    "CREATE_PROCESS.ENTRY_POINT": "INVALID_PARAM",
 }
 # Pointer cases beyond the parameters: a field of a parameter, another length.
 NULL_EXTRA = ["CREATE_PROCESS.ENTRY_POINT", "REPORT_APPLICATION_MESSAGE.MESSAGE_ADDR_LENGTH_0"]
@@ -56,17 +59,24 @@ def pointer_parameters() -> list[str]:
 
 def _null_checks() -> dict:
     table = {}
-    for case in pointer_parameters() + NULL_EXTRA:
-        table[case] = NULL_EXCEPTIONS.get(case, "INVALID_PARAM")
+    for case in NULL_EXCEPTIONS:
+        table[case] = NULL_EXCEPTIONS[case]
         table[f"untouched.{case}"] = "yes"
     return table
+
+
+def _illegal_nulls() -> list[str]:
+    return [c for c in pointer_parameters() + NULL_EXTRA if c not in NULL_EXCEPTIONS]
 
 
 def _fault_checks() -> dict:
     services = [s for s, _ in apex_coverage.services() if s != "STOP_SELF"]
     table = {f"rc_null.{s}": "ILLEGAL_REQUEST" for s in services + BAD_ADDRESSES}
+    for case in _illegal_nulls():
+        table[f"null.{case}"] = "ILLEGAL_REQUEST"
+        table[f"untouched.{case}"] = "yes"
     table["rc_null.message"] = "yes"
-    table["rc_null.cases_run"] = len(services) + len(BAD_ADDRESSES)
+    table["rc_null.cases_run"] = len(services) + len(BAD_ADDRESSES) + len(_illegal_nulls())
     return table
 
 
@@ -85,7 +95,8 @@ def test_the_tables_cover_the_headers():
     # Every service but STOP_SELF has a RETURN_CODE; a parser that found too few pointer
     # parameters would make the null table pass vacuously.
     assert len(pointer_parameters()) >= 60
-    assert len(_fault_checks()) >= 64
+    assert len(_illegal_nulls()) >= 60
+    assert len(_fault_checks()) >= 124
 
 
 def test_faults_are_illegal_requests_decided_at_process_level(apex):

@@ -4,8 +4,10 @@
  * Partitions cannot host Cyclone DDS (it starts threads; the partitions' seccomp filter forbids
  * them), so each node runs one agent process beside its SKE: the node's DDS participant. The
  * io partition (the system partition, the only one with Linux I/O) talks to it over one
- * Unix-domain SOCK_SEQPACKET connection at $IMA_XCH. Every datagram starts with struct
- * xch_hdr; its size is exactly sizeof(hdr) + the payload size of its type.
+ * Unix-domain SOCK_SEQPACKET connection, at the path of io's --dds argument (the node's module
+ * gives it: `{dds_socket}` in the system model, ddsK.sock in the run's socket directory; the
+ * agent listens there with --socket). Every datagram starts with struct xch_hdr; its size is
+ * exactly sizeof(hdr) + the payload size of its type.
  *
  * io -> agent
  *   HELLO      once after connecting; hdr.node = this node (1..XCH_MAX_NODES).

@@ -2,9 +2,10 @@
 /* The RPAS application's intra-node port messages: what the io partition, nav_fcs and (later)
  * the mission manager exchange through sampling ports. Engineering units, doubles, each
  * message stamped with the emulated time its data was taken (the end of the CAN frame it came
- * from, or the time the producing partition computed it). Port names are in the module XML
- * (config/nodes/). A message that stops coming makes its port INVALID after the port's
- * refresh period: that is how a consumer sees a lost sensor, link or partition. */
+ * from, or the time the producing partition computed it). Port names, sizes and the struct each
+ * port carries are in the system model (config/applications/rpas.yaml), from which the build
+ * generates the partitions' contract. A message that stops coming makes its port INVALID after
+ * the port's refresh period: that is how a consumer sees a lost sensor, link or partition. */
 #ifndef RPAS_PORTS_H
 #define RPAS_PORTS_H
 

@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """DDS of a run: its domain id, the loopback-only Cyclone configuration, socket confinement.
 
-Every DDS process of the product (the nodes' agents, the recorder, `python -m ima.dds.listen`,
-the benchmark's ddsperf) runs with config/dds/cyclonedds-loopback.xml and the run's own
+Every DDS process of the product (the nodes' agents, `python -m ima.dds.listen`, the
+benchmark's ddsperf) runs with config/dds/cyclonedds-loopback.xml and the run's own
 domain id. Nothing here imports cyclonedds: the launcher uses it without loading Cyclone.
 """
 

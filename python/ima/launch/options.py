@@ -32,7 +32,7 @@ class LaunchOptions:
     wind_from_deg: float = 270.0
     realtime: bool = False
     run_dir: Path | None = None  # default: runs/<kind>-<date>-<time>-seed<N>
-    kind: str = "launch"  # the run directory's prefix: launch, fly
+    kind: str = "launch"  # the run directory's prefix: launch, fly, demo
     kill: list[tuple[str, float]] = field(default_factory=list)  # (node, emulated s)
     hang: list[tuple[str, float]] = field(default_factory=list)  # (node, emulated s)
     # test-only: (node, axis, offset, from emulated s): that replica's command is wrong

@@ -13,9 +13,9 @@ Files in the run directory:
   launch.json    how the run was started (system, domain ID, commands, faults)
   can.jsonl      every frame on the bus; canbus.json its statistics; canbus.log
   nodeK.jsonl    node K's SKE trace (schedule, HM, partition reports); nodeK.json; nodeK.log
-  ddsK.jsonl     node K's DDS agent trace (wall clock); ddsK.json its statistics
+  ddsK.jsonl     node K's DDS agent trace (wall clock); ddsK.json its statistics; nodeK-dds.log
   truth.jsonl    the aircraft's true state; world.jsonl, world.json, world.log
-  summary.json   written by ima.launch.summary
+  summary.json   written by ima.launch.summary, with flight.png
 """
 
 from __future__ import annotations

@@ -38,10 +38,13 @@ def _run(checkout: Path, target: str, cpu: int | None, extra: list[str]) -> dict
     done = subprocess.run(cmd, capture_output=True, text=True, cwd=checkout, env=env)
     if done.returncode != 0:
         raise ImaError(f"{' '.join(cmd)} failed ({done.returncode}): {done.stderr.strip()[-500:]}")
-    try:
-        return json.loads(done.stdout.strip().splitlines()[-1])
-    except (ValueError, IndexError) as exc:
-        raise ImaError(f"{' '.join(cmd)} printed no JSON: {done.stdout[-300:]!r}") from exc
+    text = done.stdout.strip()
+    for candidate in (text, text.splitlines()[-1] if text else ""):  # whole, or its last line
+        try:
+            return json.loads(candidate)
+        except ValueError:
+            continue
+    raise ImaError(f"{' '.join(cmd)} printed no JSON: {done.stdout[-300:]!r}")
 
 
 def compare(base: Path, target: str, pairs: int = 5, cpu: int | None = 0,

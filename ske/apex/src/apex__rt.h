@@ -4,7 +4,10 @@
 #ifndef APEX__RT_H
 #define APEX__RT_H
 
+#include <signal.h>
+#include <string.h>
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <ucontext.h>
 
@@ -147,25 +150,22 @@ bool apex__port_map(int k);
 bool apex__may_block(void);
 /* Brackets a copy from or to memory the caller named: a fault inside is an APEX service
  * given an invalid address, an ILLEGAL_REQUEST rather than a MEMORY_VIOLATION. */
-void apex__user_copy(bool on);
+extern volatile sig_atomic_t apex__in_user_copy; /* read by the fault handler (hm.c) */
+static inline void apex__user_copy(bool on) { apex__in_user_copy = on; }
 /* The caller gave an address the service cannot use where it can return no error code (a
  * null or unwritable RETURN_CODE), or one that faulted: an ILLEGAL_REQUEST for the health
  * monitor, the same path as a fault inside apex__user_copy. The caller does not go on. */
 void apex__invalid_address(const void *address);
 
-/* The addresses a caller gives a service (user.c). Every service starts with apex__enter:
- * it brings time up to date and checks RETURN_CODE; false means the service must return at
- * once (the health monitor has the caller's ILLEGAL_REQUEST). The others check an address: a
- * null one, or one that cannot be read (or written, for an output), is an ILLEGAL_REQUEST, as
- * when a message copy faults; they return false only if the health monitor let the caller go
- * on, and the service then answers INVALID_PARAM. */
-bool apex__enter(RETURN_CODE_TYPE *rc);
-bool apex__out_ok(void *p, size_t n);
-/* A message address, checked where it is used (the copy is bracketed by apex__user_copy). */
-bool apex__addr_ok(const void *p);
-bool apex__in_ok(const void *p, size_t n);
-/* A name parameter: readable up to its NUL or MAX_NAME_LENGTH characters. */
-bool apex__name_ok(const char *name);
+/* The addresses a caller gives a service (apex__user.h, inline: every service call checks
+ * some). Every service starts with apex__enter: it brings time up to date and checks
+ * RETURN_CODE; false means the service must return at once (the health monitor has the
+ * caller's ILLEGAL_REQUEST). The others check an address: a null one, or one that cannot be
+ * read (or written, for an output), is an ILLEGAL_REQUEST, as when a message copy faults;
+ * they return false only if the health monitor let the caller go on, and the service then
+ * answers INVALID_PARAM. apex__addr_ok checks a message address for null only: its copy is
+ * bracketed by apex__user_copy. */
+#include "apex__user.h"
 
 /* Sampling ports (sampling.c), shared with the Part 2 extensions (sampling_ext.c). VALID when
  * a message stamped `stamp` is at most port k's refresh period old now. */

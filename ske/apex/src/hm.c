@@ -21,9 +21,7 @@
 #define EH_STACK_MAX (64u * 1024u * 1024u)
 #define EH_PRIORITY (MAX_PRIORITY_VALUE + 1) /* above every process */
 
-static volatile sig_atomic_t in_user_copy;
-
-void apex__user_copy(bool on) { in_user_copy = on; }
+volatile sig_atomic_t apex__in_user_copy;
 
 /* The lowest address of the initialisation process's stack (the main thread's). */
 static uintptr_t main_stack_lo;
@@ -212,8 +210,8 @@ static void on_fault(int sig, siginfo_t *si, void *uctx)
         n = snprintf(msg, sizeof msg, "system call %d denied", si->si_syscall);
         break;
     default: /* SIGSEGV, SIGBUS */
-        if (in_user_copy) {
-            in_user_copy = 0;
+        if (apex__in_user_copy) {
+            apex__in_user_copy = 0;
             err = HM_ERR_ILLEGAL_REQUEST;
             n = snprintf(msg, sizeof msg, "APEX service given an invalid address (%p)", si->si_addr);
             break;

@@ -14,9 +14,9 @@ the range's end. Decoding returns physical values as floats (ints for scale-1 si
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 DBC_PATH = Path(__file__).resolve().parents[3] / "config" / "can" / "rpas.dbc"
 

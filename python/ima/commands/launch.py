@@ -10,7 +10,10 @@ import json
 import sys
 from pathlib import Path
 
+from ima import provenance
 from ima.errors import ImaError
+from ima.launch import faults as fault_plan
+from ima.launch import judging as judging_mod
 from ima.launch import options as launch_options
 from ima.launch import report as launch_report
 from ima.launch import run as launch_run
@@ -72,19 +75,31 @@ def add_run_arguments(parser: argparse.ArgumentParser, kind: str = "launch") -> 
                         help=f"where the traces go (default runs/{kind}-<date>-<time>-seed<N>)")
     parser.add_argument("--json", action="store_true",
                         help="print the summary as one JSON object on stdout")
+    parser.add_argument("--fault", action="append", default=[], metavar="SPEC",
+                        help="inject a fault (repeatable), e.g. nav_fcs@node2:memory_violation@60 "
+                        "(grammar and classes: docs/fault-injection.md)")
+    parser.add_argument("--faults", type=Path, metavar="FILE.yaml",
+                        help="inject the faults a YAML file lists (docs/fault-injection.md)")
+    parser.add_argument("--no-judge", action="store_true",
+                        help="with faults: do not fly the golden run nor judge the run with the "
+                        "oracles")
+    parser.add_argument("--golden", type=Path, metavar="RUN_DIR",
+                        help="with faults: the golden run to judge against (the same run without "
+                        "faults, flown before); default: flown into RUN_DIR/golden")
     parser.add_argument("--kill-node", type=_node_at("--kill-node"), action="append", default=[],
                         metavar="NODE@SECONDS",
                         help="stop a whole processor at that emulated time (repeatable), "
-                        "e.g. node2@120")
+                        "e.g. node2@120; the same as --fault NODE:node_crash@SECONDS")
     parser.add_argument("--hang-node", type=_node_at("--hang-node"), action="append", default=[],
                         metavar="NODE@SECONDS",
                         help="freeze a processor's SKE and partitions at that emulated time "
                         "(its DDS agent lives on): a hung node, found by the DDS deadline "
-                        "(repeatable)")
+                        "(repeatable); the same as --fault NODE:node_freeze@SECONDS")
     parser.add_argument("--test-wrong-output", type=_wrong, action="append", default=[],
                         metavar="NODE@SECONDS[:AXIS=OFFSET]",
-                        help="test switch: that replica's actuator command is offset from then "
-                        "on (default elev=0.3); the voter must vote it out")
+                        help="that replica's actuator command is offset from then on (default "
+                        "elev=0.3); the same as --fault NODE:wrong_output@SECONDS:mode=bias,"
+                        "axis=AXIS,value=OFFSET")
     parser.add_argument("--netns", action="store_true",
                         help="put each node in its own network namespace joined by a bridge "
                         "(root only), so that a node can really be cut off the network")
@@ -104,13 +119,24 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return parser
 
 
+def faults_from(args: argparse.Namespace) -> list:
+    """--fault specs (f1, f2, ... in order), then the --faults file's."""
+    from faultinject import grammar
+
+    faults = [grammar.parse(spec, f"f{k}") for k, spec in enumerate(args.fault, start=1)]
+    if args.faults is not None:
+        faults += grammar.from_yaml_file(args.faults, first=len(faults) + 1)
+    return grammar.check_ids(faults, "the run's faults")
+
+
 def options_from(args: argparse.Namespace, system: Path | None = None,
                  kind: str = "launch") -> launch_options.LaunchOptions:
     return launch_options.LaunchOptions(
         system=system or args.system, duration_s=args.duration, seed=args.seed, pilot=args.pilot,
         turbulence=args.turbulence, wind_kt=args.wind, realtime=args.realtime,
         run_dir=args.run_dir, kind=kind, kill=list(args.kill_node), hang=list(args.hang_node),
-        wrong_output=list(args.test_wrong_output), netns=args.netns)
+        wrong_output=list(args.test_wrong_output), netns=args.netns, faults=faults_from(args),
+        judge=not args.no_judge, golden=args.golden)
 
 
 def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> int:
@@ -131,7 +157,14 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> 
     task = progress.add_task("flight", total=opts.duration_s)
     if opts.run_dir is None:
         opts.run_dir = launch_options.new_run_dir(opts.kind, opts.seed)
-    state = LiveState(Path(opts.run_dir), nodes, dict(opts.kill), hangs=dict(opts.hang))
+    wanted = fault_plan.requested(opts)
+    judging = bool(wanted) and opts.judge
+    if judging:
+        opts.port_hashes = True  # the data-isolation oracle compares them with the golden run
+    stops = {cls: {f.target.node: f.trigger.at_s for f in wanted
+                   if f.cls == cls and f.trigger.at_s is not None}
+             for cls in ("node_crash", "node_freeze")}
+    state = LiveState(Path(opts.run_dir), nodes, stops["node_crash"], hangs=stops["node_freeze"])
 
     with Live(progress, console=console, transient=True, refresh_per_second=4) as live:
         def on_status(st: dict) -> None:
@@ -145,6 +178,14 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> 
                                        hung=result.hung)
     summary["returncodes"] = result.returncodes
     summary["dds_domain"] = result.domain
+    summary["provenance"] = provenance.provenance()
+    if result.plan is not None:
+        summary["faults"] = [{"id": f.fid, "spec": f.spec(), "class": f.cls,
+                              "t_s": f.trigger.at_s, "applied": None} for f in result.plan.faults]
+        if judging and not result.interrupted:
+            with console.status("judging the run: the golden run, then the oracles"):
+                summary.update(judging_mod.judge(opts, result, system))
+        launch_summary.write(result.run_dir, summary)
     failed = {k: v for k, v in result.returncodes.items()
               if v not in (0, None) and k.split("/")[0] not in {**result.killed, **result.hung}}
     if json_out:

@@ -11,8 +11,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ima.errors import ImaError
-
 DEFAULT_SETTLE_S = 60.0
 MODE_NAMES = {0: "INIT", 1: "DIRECT", 2: "AUTOPILOT", 3: "MISSION", 4: "CONTINGENCY"}
 FALLBACK_NAMES = {0: "NONE", 1: "C2_LOST", 2: "MISSION_STALE", 3: "NAV_INVALID", 4: "NO_TARGETS"}

@@ -10,6 +10,7 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from faultinject.plan import Plan
 from ima import paths
 from ima.deploy import System
 from ima.deploy.model import VOTING_AXES, canbus_socket_name, dds_socket_name
@@ -38,8 +39,8 @@ def partition_path(first: list[Path]) -> str:
 
 
 def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pilot: Path,
-         modules: dict[str, Path], kills: dict[str, float], hangs: dict[str, float],
-         domain: int | None) -> RunPlan:
+         modules: dict[str, Path], faults: Plan, domain: int | None) -> RunPlan:
+    """The command lines; `faults` gives the injectors' words (faultinject.plan)."""
     names = [n.name for n in system.nodes]
     index = {n.name: n.index for n in system.nodes}
     n = len(names)
@@ -48,10 +49,11 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
            "--quantum-us", str(opts.quantum_us), "--bitrate", str(int(system.can["bitrate"])),
            "--lockstep-clients", str(1 + n), "--duration", f"{opts.duration_s:g}",
            "--trace", str(run_dir / "can.jsonl"), "--stats", str(run_dir / "canbus.json"), "-q"]
-    for node, t in kills.items():
+    for node, t in faults.kills.items():
         bus += ["--kill-node", f"{index[node]}@{t:g}"]
-    for node, t in hangs.items():
+    for node, t in faults.hangs.items():
         bus += ["--hang-node", f"{index[node]}@{t:g}"]
+    bus += faults.bus
     # Every node's io partition joins in the first quantum, all at once: fixed indices keep
     # the bus trace the same from run to run.
     bus += ["--client-order", ",".join([*names, "world", *(f"{x}/io" for x in names)])]
@@ -69,6 +71,7 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
                   "--vote-persist", str(int(v["persist"])),
                   "--vote-offset", f"{float(v['offset_s']):g}",
                   "--vote-period", f"{system.major_frame_s:g}"]
+    world += faults.world
     out = RunPlan(sock_dir=sock_dir, bus=bus, world=world)
 
     for node in names:
@@ -83,21 +86,11 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
                    "--stats", str(run_dir / f"dds{k}.json"), "-q"]
             if opts.realtime:
                 cmd.append("--realtime")
-            out.agents[f"{node}/dds"] = cmd
+            out.agents[f"{node}/dds"] = cmd + faults.dds.get(node, [])
         out.nodes[node] = [
             str(paths.ske_binary()), "--lockstep", str(sock), "--node", node,
             "--node-index", str(k), "--partition-path", partition_path(opts.partition_path),
             "--trace", str(run_dir / f"{node}.jsonl"), "--stats", str(run_dir / f"{node}.json"),
-            "-q", "--", str(modules[node])]
-    return out
-
-
-def test_switches(system: System, opts: LaunchOptions) -> dict[tuple[str, str], list[str]]:
-    """The run's test switches as arguments of a node's partition (ima deploy adds them to
-    that node's module): --test-wrong-output makes io offset its replica's command."""
-    out: dict[tuple[str, str], list[str]] = {}
-    io = next((p.name for p in system.partitions if p.name == "io"), None)
-    for node, axis, value, t in opts.wrong_output:
-        if io is not None:
-            out.setdefault((node, io), []).append(f"--test-cmd-bias={axis}={value:g}@{t:g}")
+            "-q", *(["--trace-port-hashes"] if opts.port_hashes else []),
+            *faults.ske.get(node, []), "--", str(modules[node])]
     return out

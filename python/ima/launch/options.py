@@ -41,6 +41,13 @@ class LaunchOptions:
     quantum_us: int = DEFAULT_QUANTUM_US
     # folders searched for the partition programs before the build's (a scratch build)
     partition_path: list[Path] = field(default_factory=list)
+    # faultinject.Fault: --fault / --faults (the older options above are folded in)
+    faults: list = field(default_factory=list)
+    # with faults: fly the golden run too (same run without faults) and judge the run
+    # against it with the oracles (faultinject.judge); `golden` reuses a golden run
+    judge: bool = True
+    golden: Path | None = None
+    port_hashes: bool = False  # the SKEs trace a hash of every port message (data isolation)
 
 
 @dataclass
@@ -53,6 +60,7 @@ class LaunchRun:
     killed: dict[str, float]  # node -> emulated time it was stopped at
     domain: int | None
     hung: dict[str, float] = field(default_factory=dict)  # node -> emulated time it froze at
+    plan: object = None  # faultinject.plan.Plan of the run's faults (None without faults)
 
 
 def default_pilot() -> Path:

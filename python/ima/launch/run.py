@@ -33,6 +33,7 @@ from pathlib import Path
 from ima.deploy.model import canbus_socket_name, dds_socket_name
 from ima.errors import ImaError
 from ima.launch import commands, procs
+from ima.launch import faults as fault_plan
 from ima.launch.options import (
     TURBULENCE,
     LaunchOptions,
@@ -45,36 +46,13 @@ from ima.launch.options import (
 _READY_TIMEOUT_S = 60.0
 
 
-def _faults(opts: LaunchOptions, system) -> tuple[dict[str, float], dict[str, float]]:
-    """The nodes to kill and to hang, checked against the system and the duration."""
-    names = [n.name for n in system.nodes]
-    kills: dict[str, float] = {}
-    hangs: dict[str, float] = {}
-    for option, faults, chosen in (("--kill-node", opts.kill, kills),
-                                   ("--hang-node", opts.hang, hangs)):
-        for node, t in faults:
-            if node not in names:
-                raise ImaError(f"{option} {node}@{t:g}: no node '{node}' in {system.path} "
-                               f"(nodes: {', '.join(names)})")
-            if t >= opts.duration_s:
-                raise ImaError(f"{option} {node}@{t:g}: after the end of the run "
-                               f"({opts.duration_s:g} s)")
-            chosen[node] = min(t, chosen.get(node, t))
-    both = sorted(set(kills) & set(hangs))
-    if both:
-        raise ImaError(f"{', '.join(both)}: a node is either killed or hung, not both")
-    for node, _axis, _v, _t in opts.wrong_output:
-        if node not in names:
-            raise ImaError(f"--test-wrong-output: no node '{node}' in {system.path}")
-    return kills, hangs
-
-
-def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None) -> LaunchRun:
-    """Runs the system to its end (or Ctrl-C); the caller summarises the run directory."""
-    from imaworld import pilot as pilot_script
-
+def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None,
+           stop_when: Callable[[dict], bool] | None = None) -> LaunchRun:
+    """Runs the system to its end (or Ctrl-C, or the first status line `stop_when` accepts);
+    the caller summarises the run directory."""
     from ima import dds
     from ima.deploy import generate, load_system
+    from imaworld import pilot as pilot_script
 
     if opts.turbulence not in TURBULENCE:
         raise ImaError(f"--turbulence must be one of {', '.join(TURBULENCE)}")
@@ -82,7 +60,6 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
         raise ImaError("--duration must be positive")
     system = load_system(Path(opts.system))
     names = [n.name for n in system.nodes]
-    kills, hangs = _faults(opts, system)
     if opts.netns and os.geteuid() != 0:
         raise ImaError("--netns needs root (it creates network namespaces)")
     pilot = Path(opts.pilot) if opts.pilot else default_pilot()
@@ -91,24 +68,29 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
     run_dir = Path(opts.run_dir) if opts.run_dir else new_run_dir(opts.kind, opts.seed)
     run_dir.mkdir(parents=True, exist_ok=True)
     run_dir = run_dir.resolve()  # the nodes run in the socket directory: paths are absolute
-    deployed = generate(system, run_dir / "deploy", commands.test_switches(system, opts))
+    plan = fault_plan.prepare(opts, system, run_dir, launch)
+    kills, hangs = plan.kills, plan.hangs
+    both = sorted(set(kills) & set(hangs))
+    if both:
+        raise ImaError(f"{', '.join(both)}: a node is either killed or hung, not both")
+    deployed = generate(system, run_dir / "deploy",
+                        {(node, "io"): words for node, words in plan.io.items()})
     sock_dir, sock_tmp = socket_dir(run_dir)
     domain = dds.domain_for_run() if len(names) > 1 else None
-    plan = commands.plan(system, opts, run_dir, sock_dir, pilot, deployed.modules, kills, hangs,
-                         domain)
+    procs_plan = commands.plan(system, opts, run_dir, sock_dir, pilot, deployed.modules, plan,
+                               domain)
     (run_dir / "launch.json").write_text(json.dumps({
         "kind": opts.kind, "system": str(system.path), "nodes": names, "seed": opts.seed,
         "duration_s": opts.duration_s, "pilot": str(pilot), "turbulence": opts.turbulence,
         "wind_kt": opts.wind_kt, "wind_from_deg": opts.wind_from_deg, "realtime": opts.realtime,
         "quantum_us": opts.quantum_us, "dds_domain": domain,
         "dds_config": str(system.dds["config"]),
-        "kill": [{"node": k, "t_s": t} for k, t in kills.items()],
-        "hang": [{"node": k, "t_s": t} for k, t in hangs.items()],
-        "wrong_output": [{"node": a, "axis": b, "offset": c, "t_s": d}
-                         for a, b, c, d in opts.wrong_output],
-        "netns": opts.netns, "socket": str(plan.bus_socket), "socket_dir": str(sock_dir),
+        "faults": [{"id": f.fid, "spec": f.spec(), "class": f.cls, "t_s": f.trigger.at_s}
+                   for f in plan.faults],
+        "netns": opts.netns, "socket": str(procs_plan.bus_socket), "socket_dir": str(sock_dir),
         "modules": {k: str(v) for k, v in deployed.modules.items()},
-        "commands": {"canbus": plan.bus, "world": plan.world, **plan.agents, **plan.nodes},
+        "commands": {"canbus": procs_plan.bus, "world": procs_plan.world, **procs_plan.agents,
+                     **procs_plan.nodes},
     }, indent=2) + "\n")
 
     ps = procs.Processes(run_dir)
@@ -138,10 +120,10 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
 
             netns = netns_mod.Namespaces(names, run_dir)
             netns.create()
-        ps.start("canbus", plan.bus)
-        procs.wait_for_socket(plan.bus_socket, ps)
+        ps.start("canbus", procs_plan.bus)
+        procs.wait_for_socket(procs_plan.bus_socket, ps)
         agents = {}
-        for name, cmd in plan.agents.items():
+        for name, cmd in procs_plan.agents.items():
             node = name.split("/")[0]
             if netns is not None:
                 cfg = netns.dds_config(node, run_dir)
@@ -151,17 +133,17 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
         procs.wait_ready(agents, ps, _READY_TIMEOUT_S)
         netns_pids: list[int] = []
         for k, node in enumerate(names, start=1):
-            cmd = plan.nodes[node]
+            cmd = procs_plan.nodes[node]
             if netns is not None:
                 cmd = netns.wrap(node, cmd)
             proc = ps.start(node, cmd, cwd=sock_dir)
             if netns is not None:
                 netns_pids.append(proc.pid)
-            procs.wait_joined(plan.bus_socket, k, ps, pids=tuple(netns_pids))
-        world = ps.start("world", plan.world, stdout=subprocess.PIPE)
+            procs.wait_joined(procs_plan.bus_socket, k, ps, pids=tuple(netns_pids))
+        world = ps.start("world", procs_plan.world, stdout=subprocess.PIPE)
         watch = procs.Watch(ps, kills)
         threading.Thread(target=watch, daemon=True).start()
-        procs.follow_world(world, on_status)
+        procs.follow_world(world, _watching(on_status, stop_when, ps))
         # A hung processor is switched off at the end of the run: its frozen processes would
         # not even take a SIGTERM. Its agent ends with the others.
         for node in hangs:
@@ -190,4 +172,25 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None)
             f"{k} {v}" for k, v in ps.failed.items()) + f" (run directory {run_dir})")
     killed = dict(watch.killed) if watch is not None else {}
     return LaunchRun(run_dir=run_dir, nodes=names, returncodes=ps.returncodes(), wall_s=wall,
-                     interrupted=interrupted, killed=killed, domain=domain, hung=hung)
+                     interrupted=interrupted, killed=killed, domain=domain, hung=hung,
+                     plan=plan if plan.faults else None)
+
+
+def _watching(on_status: Callable[[dict], None] | None, stop_when: Callable[[dict], bool] | None,
+              ps: procs.Processes) -> Callable[[dict], None] | None:
+    """The world's status lines to on_status; the bus told to end the run at the first one
+    stop_when accepts (a run that resolves a fault's condition need go no further)."""
+    if stop_when is None:
+        return on_status
+    stopped = False
+
+    def watch(st: dict) -> None:
+        nonlocal stopped
+        if on_status is not None:
+            on_status(st)
+        if not stopped and stop_when(st):
+            stopped = True
+            bus = ps.procs.get("canbus")
+            if bus is not None and bus.poll() is None:
+                bus.send_signal(signal.SIGTERM)
+    return watch

@@ -98,5 +98,10 @@ def summarise(run_dir: Path, pilot: Path, duration_s: float, nodes: list[str],
             dds[node] = st
     if dds:
         summary["dds"] = dds
-    (run_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    write(run_dir, summary)
     return summary
+
+
+def write(run_dir: Path, summary: dict) -> None:
+    """RUN_DIR/summary.json."""
+    (run_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")

@@ -1,0 +1,126 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Judges a run with faults against its golden run: each fault confirmed or not, every
+oracle's verdict, and one outcome for the run (the FARM record of campaigns: the Fault, its
+Activation, the Readouts, the Measures)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from faultinject import catalogue, detectors, oracles
+from faultinject.context import Context
+from faultinject.evidence import check
+from faultinject.plan import Plan
+from faultinject.traces import RunTraces
+
+ORACLES = {"temporal_isolation": oracles.temporal_isolation,
+           "data_isolation": oracles.data_isolation, "detection": oracles.detection,
+           "hm_action": oracles.hm_action, "degraded_mode": oracles.degraded_mode,
+           "envelope": oracles.envelope}
+# From the worst: one outcome stands for a run of several faults.
+SEVERITY = ("undetected_hazardous", "undetected_benign", "detected_degraded",
+            "detected_recovered", "masked", "not_activated")
+
+
+def _stats(run_dir: Path, node: str) -> dict:
+    try:
+        return json.loads((run_dir / f"{node}.json").read_text())
+    except (OSError, ValueError):
+        return {}
+
+
+def degraded_at_end(ctx: Context) -> list[str]:
+    """What the run ends without that the golden run ends with: a replica voted out, a node
+    stopped or out of the membership, a partition down, a fallback in force."""
+    out = []
+    gold_out = {e.get("node") for e in ctx.golden.world_kind("voted_out")} if ctx.golden else set()
+    out += [f"{e.get('node')} voted out" for e in ctx.run.world_kind("voted_out")
+            if e.get("node") not in gold_out]
+    out += [f"{n} stopped" for n in ctx.plan.kills] + [f"{n} frozen" for n in ctx.plan.hangs]
+    for node in ctx.node_names:
+        if node in ctx.plan.kills or node in ctx.plan.hangs:
+            continue
+        run = {p["name"]: p.get("state") for p in _stats(ctx.run.run_dir, node).get(
+            "partitions", [])}
+        gold = {p["name"]: p.get("state") for p in _stats(ctx.golden.run_dir, node).get(
+            "partitions", [])} if ctx.golden else {}
+        out += [f"{p}@{node} {s}" for p, s in run.items() if s != gold.get(p, s)]
+        for e in ctx.run.app_messages(node):
+            if e.get("text", "").startswith("membership ") and "(lost " in e["text"]:
+                out.append(f"{node}: {e['text']}")
+                break
+    last = {k: d for _t, k, d in ctx.run.fcs_status}
+    gold_last = {k: d for _t, k, d in ctx.golden.fcs_status} if ctx.golden else {}
+    for k, d in last.items():
+        g = gold_last.get(k, {})
+        if d.get("FCS_FALLBACK") != g.get("FCS_FALLBACK") or d.get("FCS_MODE") != g.get("FCS_MODE"):
+            out.append(f"channel {k}: mode {d.get('FCS_MODE')} fallback {d.get('FCS_FALLBACK')} "
+                       f"at the end")
+            break
+    return out
+
+
+def _outcome(confirmed: bool, detected: bool, degraded: bool, identical: bool,
+             env_left: bool) -> str:
+    if not confirmed:
+        return "not_activated"
+    if detected:
+        return "detected_degraded" if degraded else "detected_recovered"
+    if env_left:
+        return "undetected_hazardous"
+    if identical or not degraded:
+        return "masked" if identical else "undetected_benign"
+    return "undetected_benign"
+
+
+def judge(run_dir: Path, golden_dir: Path | None, plan: Plan, system, duration_s: float) -> dict:
+    """The `faults`, `oracles` and `outcome` of a run's summary."""
+    ctx = Context(run=RunTraces(run_dir), golden=RunTraces(golden_dir) if golden_dir else None,
+                  plan=plan, system=system, duration_s=duration_s)
+    conf = [check(ctx, inj) for inj in plan.injections]
+    verdicts = {"confirmation": {
+        "verdict": "pass" if all(c.confirmed for c in conf) else "fail",
+        "unconfirmed": [c.fid + (f"@{c.node}" if c.node else "") + f": {c.evidence}"
+                        for c in conf if not c.confirmed]}}
+    verdicts.update({name: fn(ctx, conf) for name, fn in ORACLES.items()})
+    degraded = degraded_at_end(ctx)
+    identical = ctx.golden is not None and ctx.run.truth_bytes == ctx.golden.truth_bytes
+    env_left = bool(verdicts["envelope"]["left"]) or verdicts["envelope"]["crashed"]
+    faults, outcomes = [], []
+    for f in plan.faults:
+        mine = [(inj, c) for inj, c in zip(plan.injections, conf, strict=True)
+                if inj.fid == f.fid]
+        t = min((c.t_ns for _, c in mine if c.t_ns is not None), default=None)
+        detected = {}
+        for inj, c in mine:
+            if c.t_ns is not None:
+                detected.update(detectors.fired(ctx, inj, c.t_ns))
+        confirmed = all(c.confirmed for _, c in mine)
+        fc = catalogue.get(f.cls)
+        outcome = _outcome(confirmed, bool(detected), bool(degraded), identical, env_left)
+        expected = fc.expected_outcomes(ctx.redundant)
+        outcomes.append(outcome)
+        first = min(detected.values(), default=None)
+        faults.append({
+            "id": f.fid, "spec": f.spec(), "class": f.cls, "layer": fc.layer,
+            "requested_t_s": f.trigger.at_s, "applied": confirmed,
+            "t_s": None if t is None else t / 1e9,
+            "evidence": [{"node": c.node, "evidence": c.evidence,
+                          "t_s": None if c.evidence_t_ns is None else c.evidence_t_ns / 1e9}
+                         for _, c in mine],
+            "detected_by": sorted(detected), "latency_ms": None if first is None or t is None
+            else round((first - t) / 1e6, 3),
+            "outcome": outcome, "expected_outcomes": list(expected),
+            "known_limit": fc.known_limit["reason"] if fc.known_limit_applies(
+                ctx.redundant, f.target.node == "*") else None,
+        })
+    run_outcome = min(outcomes, key=SEVERITY.index) if outcomes else "not_activated"
+    bad = [f["id"] for f in faults if f["outcome"] not in f["expected_outcomes"]]
+    verdicts["outcome"] = {"verdict": "fail" if bad else "pass", "outcome": run_outcome,
+                           "unexpected": bad}
+    violations = sorted(k for k, v in verdicts.items() if v.get("verdict") == "fail")
+    known = [f["id"] for f in faults if f["known_limit"]]
+    return {"faults": faults, "oracles": verdicts, "outcome": run_outcome,
+            "oracle_violations": violations, "degraded": degraded,
+            "known_limit": known, "truth_identical": identical}

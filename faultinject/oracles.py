@@ -1,0 +1,270 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The oracles: each judges one property of a run against its golden run (the same system,
+workload and seed without the faults), from the run's records, never from what a component
+says of itself. Each gives {"verdict": "pass" | "fail" | "n/a", ...its findings}."""
+
+from __future__ import annotations
+
+from faultinject import catalogue, detectors, hm_tables
+from faultinject.context import Context
+from faultinject.evidence import Confirmation
+from faultinject.plan import Injection
+
+# The safe envelope, judged on the truth (docs/fault-injection.md).
+ENVELOPE = {"bank_deg": 60.0, "pitch_up_deg": 25.0, "pitch_down_deg": -20.0,
+            "airspeed_min_kt": 55.0, "airspeed_max_kt": 160.0, "agl_min_ft": 200.0}
+# How far a masked fault's flight may depart from the golden run's when the catalogue says
+# `tracking` (the truth cannot be bit-identical, and says why).
+TRACKING = {"alt_ft": 100.0, "airspeed_kt": 15.0, "heading_deg": 15.0}
+
+
+def _targets(inj: Injection) -> set[tuple[str, str | None]]:
+    """(node, partition) the fault acts on directly; partition None: every one of the node."""
+    f = inj.fault
+    if f.target.partition is not None:
+        return {(inj.node, f.target.partition)}
+    if f.cls in ("node_crash", "node_freeze", "module_reset"):
+        return {(inj.node, None)}
+    return set()
+
+
+def _excluded(ctx: Context, node: str, partition: str) -> bool:
+    return any((n, p) in ((node, partition), (node, None))
+               for inj in ctx.plan.injections for n, p in _targets(inj))
+
+
+def temporal_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
+    """Every partition but the targets gets each of its windows at its planned start, yields
+    at the same time as in the golden run (the same work: its releases and time-outs), and has
+    no overrun nor HM event."""
+    if ctx.golden is None:
+        return {"verdict": "n/a", "why": "no golden run"}
+    findings, checked = [], 0
+    for node in ctx.node_names:
+        for p in ctx.system.partitions:
+            if _excluded(ctx, node, p.name):
+                continue
+            checked += 1
+            run, gold = ctx.run.windows(node, p.name), ctx.golden.windows(node, p.name)
+            if run != gold:
+                diff = next((i for i, (a, b) in enumerate(zip(run, gold, strict=False))
+                             if a != b), min(len(run), len(gold)))
+                got = run[diff] if diff < len(run) else None
+                want = gold[diff] if diff < len(gold) else None
+                findings.append({"node": node, "partition": p.name, "window": diff,
+                                 "run": got, "golden": want})
+            for kind in ("overrun", "hm"):
+                extra = [e for e in ctx.run.node_kind(node, kind) if e.get("partition") == p.name]
+                if len(extra) > len([e for e in ctx.golden.node_kind(node, kind)
+                                     if e.get("partition") == p.name]):
+                    findings.append({"node": node, "partition": p.name, kind: extra[0]})
+    return {"verdict": "fail" if findings else "pass", "partitions_checked": checked,
+            "violations": findings[:10]}
+
+
+def _downstream(ctx: Context, origins: set[tuple[str, str | None]]) -> set[tuple[str, str]]:
+    """(node, partition) reachable from the origins in the system's channel graph: the
+    intra-node channels, the CAN bus between the partitions that use it (and the world, which
+    closes the loop), DDS between the same partition of every node."""
+    s = ctx.system
+    can_parts = {p for traffic in s.can_traffic.values() for p in traffic}
+    dds_parts = {t["partition"] for t in s.dds_topics}
+    every = {(n, p.name) for n in ctx.node_names for p in s.partitions}
+    seen: set = set()
+    todo = [("world", None)] if not origins else list(origins)
+    while todo:
+        node, part = todo.pop()
+        if (node, part) in seen:
+            continue
+        seen.add((node, part))
+        if node == "world":
+            todo += [(n, p) for n, p in every if p in can_parts]
+            continue
+        if part is None:
+            todo += [(node, p.name) for p in s.partitions]
+            continue
+        for ch in s.channels:
+            if ch.source.partition == part:
+                todo += [(node, d.partition) for d in ch.destinations]
+        if part in can_parts:
+            todo += [(n, p) for n, p in every if p in can_parts] + [("world", None)]
+        if part in dds_parts:
+            todo += [(n, part) for n in ctx.node_names]
+    return {x for x in seen if x[0] != "world" and x[1] is not None}
+
+
+def _truth_divergence(ctx: Context) -> int | None:
+    for a, b in zip(ctx.run.truth, ctx.golden.truth, strict=False):
+        if a != b:
+            return a["t_ns"]
+    return None
+
+
+def data_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
+    """Before the first fault acts, every source port writes what it wrote in the golden run;
+    a partition not downstream of any target in the channel graph does so up to the first
+    divergence of the truth (after which the physical loop carries the fault everywhere)."""
+    if ctx.golden is None:
+        return {"verdict": "n/a", "why": "no golden run"}
+    hashes = {n: ctx.run.port_hashes(n) for n in ctx.node_names}
+    if not any(hashes.values()):
+        return {"verdict": "n/a", "why": "the run traced no port hashes"}
+    t_first = min((c.t_ns for c in conf if c.t_ns is not None), default=None)
+    origins = set()
+    for inj in ctx.plan.injections:
+        origins |= _targets(inj) or ({(inj.node, "io")} if inj.node in ctx.node_names
+                                     else {("world", None)})
+    downstream = _downstream(ctx, origins)
+    t_div = _truth_divergence(ctx)
+    findings, compared = [], 0
+    for node in ctx.node_names:
+        gold = ctx.golden.port_hashes(node)
+        for key, run_seq in hashes[node].items():
+            free = (node, key[0]) not in downstream
+            limit = t_div if free else t_first
+            if limit is None:
+                limit = 1 << 62
+            a = [x for x in run_seq if x[0] < limit]
+            b = [x for x in gold.get(key, []) if x[0] < limit]
+            compared += len(b)
+            if a != b:
+                at = next((x[0] for x, y in zip(a, b, strict=False) if x != y), limit)
+                findings.append({"node": node, "partition": key[0], "port": key[1], "t_s": at / 1e9,
+                                 "downstream": not free})
+    return {"verdict": "fail" if findings else "pass", "messages_compared": compared,
+            "not_downstream": sorted(f"{p}@{n}" for n, p in
+                                     {(n, p.name) for n in ctx.node_names
+                                      for p in ctx.system.partitions} - downstream),
+            "truth_diverges_s": None if t_div is None else t_div / 1e9,
+            "violations": findings[:10]}
+
+
+def detection(ctx: Context, conf: list[Confirmation]) -> dict:
+    """Per fault: the detectors the catalogue expects fired, within its latency bound from the
+    confirmed injection; and every detector that fired at all."""
+    per_fault, ok = [], True
+    for inj, c in zip(ctx.plan.injections, conf, strict=True):
+        fc = catalogue.get(inj.fault.cls)
+        want = fc.detectors(ctx.redundant)
+        if c.t_ns is None:
+            per_fault.append({"fault": inj.fid, "node": inj.node, "verdict": "n/a",
+                              "why": "not confirmed"})
+            continue
+        fired = detectors.fired(ctx, inj, c.t_ns)
+        latency = {k: (t - c.t_ns) / 1e6 for k, t in fired.items()}
+        if want == ("none",):
+            verdict = "pass"
+        else:
+            good = [k for k in want if k in latency and latency[k] <= fc.latency_ms]
+            verdict = "pass" if good else "fail"
+        ok = ok and verdict != "fail"
+        first = min(latency.values()) if latency else None
+        per_fault.append({"fault": inj.fid, "node": inj.node, "verdict": verdict,
+                          "expected": list(want), "bound_ms": fc.latency_ms,
+                          "fired_ms": {k: round(v, 3) for k, v in latency.items()},
+                          "latency_ms": None if first is None else round(first, 3)})
+    return {"verdict": "pass" if ok else "fail", "faults": per_fault}
+
+
+def hm_action(ctx: Context, conf: list[Confirmation]) -> dict:
+    """Every health-monitor decision of the run is one the node's module tables prescribe,
+    computed here from the module XML (faultinject.hm_tables)."""
+    findings, checked = [], 0
+    for node in ctx.node_names:
+        try:
+            tables = hm_tables.read(ctx.run.module(node))
+        except (OSError, ValueError) as exc:
+            return {"verdict": "fail", "why": f"cannot read {node}'s module: {exc}"}
+        for e in ctx.run.node_kind(node, "hm"):
+            checked += 1
+            allowed = hm_tables.expected(tables, e.get("partition"), e.get("state"),
+                                         e.get("error"))
+            got = (e.get("level"), e.get("action"))
+            if got not in allowed:
+                findings.append({"node": node, "t_s": e["t_ns"] / 1e9,
+                                 "partition": e.get("partition"), "error": e.get("error"),
+                                 "state": e.get("state"), "applied": list(got),
+                                 "tables": sorted(list(x) for x in allowed)})
+    return {"verdict": "fail" if findings else "pass", "decisions_checked": checked,
+            "violations": findings[:10]}
+
+
+def degraded_mode(ctx: Context, conf: list[Confirmation]) -> dict:
+    """The mode (and fallback) the catalogue expects the flight control to reach, reached on
+    the downlink within the class's bound."""
+    per_fault, ok = [], True
+    for inj, c in zip(ctx.plan.injections, conf, strict=True):
+        want = catalogue.get(inj.fault.cls).mode
+        if not want or c.t_ns is None:
+            continue
+        t = detectors.reached_mode(ctx, c.t_ns, want["mode"], want.get("fallback"))
+        bound = catalogue.get(inj.fault.cls).latency_ms
+        good = t is not None and (t - c.t_ns) / 1e6 <= bound
+        ok = ok and good
+        per_fault.append({"fault": inj.fid, "expected": want, "bound_ms": bound,
+                          "reached_ms": None if t is None else round((t - c.t_ns) / 1e6, 3),
+                          "verdict": "pass" if good else "fail"})
+    if not per_fault:
+        return {"verdict": "n/a", "why": "no fault of the run expects a degraded mode"}
+    return {"verdict": "pass" if ok else "fail", "faults": per_fault}
+
+
+def envelope_findings(ctx: Context) -> dict:
+    """Where the truth left the safe envelope, and whether the aircraft crashed."""
+    worst: dict = {}
+    out = []
+    for r in ctx.run.truth:
+        checks = (("bank_deg", abs(r.get("roll_deg", 0)) > ENVELOPE["bank_deg"]),
+                  ("pitch_deg", not ENVELOPE["pitch_down_deg"] <= r.get("pitch_deg", 0)
+                   <= ENVELOPE["pitch_up_deg"]),
+                  ("airspeed_kt", not ENVELOPE["airspeed_min_kt"] <= r.get("airspeed_kt", 100)
+                   <= ENVELOPE["airspeed_max_kt"]),
+                  ("agl_ft", r.get("agl_ft", 1e9) < ENVELOPE["agl_min_ft"]))
+        for name, bad in checks:
+            if bad and name not in worst:
+                worst[name] = r["t_ns"] / 1e9
+                out.append({"limit": name, "t_s": r["t_ns"] / 1e9})
+    crashed = any(e.get("kind") == "crash" for e in ctx.run.world)
+    return {"left": out, "crashed": crashed}
+
+
+def tracking(ctx: Context) -> dict:
+    """The largest departures of the run's truth from the golden run's."""
+    d = {"alt_ft": 0.0, "airspeed_kt": 0.0, "heading_deg": 0.0}
+    for a, b in zip(ctx.run.truth, ctx.golden.truth, strict=False):
+        d["alt_ft"] = max(d["alt_ft"], abs(a.get("alt_ft", 0) - b.get("alt_ft", 0)))
+        d["airspeed_kt"] = max(d["airspeed_kt"], abs(a.get("airspeed_kt", 0) -
+                                                     b.get("airspeed_kt", 0)))
+        h = (a.get("heading_deg", 0) - b.get("heading_deg", 0) + 180) % 360 - 180
+        d["heading_deg"] = max(d["heading_deg"], abs(h))
+    return {k: round(v, 2) for k, v in d.items()}
+
+
+def envelope(ctx: Context, conf: list[Confirmation]) -> dict:
+    """The aircraft stays in its safe envelope (a class whose known limit is declared may leave
+    it: that is its outcome, not a violation); a fault the catalogue says is masked leaves the
+    truth bit-identical to the golden run, or within the tracking bounds where it says why
+    not."""
+    found = envelope_findings(ctx)
+    left = bool(found["left"]) or found["crashed"]
+    limits = [inj.fid for inj in ctx.plan.injections
+              if catalogue.get(inj.fault.cls).known_limit_applies(
+                  ctx.redundant, inj.fault.target.node == "*")]
+    result = {"left": found["left"], "crashed": found["crashed"], "known_limit": limits}
+    verdict = "fail" if left and not limits else "pass"
+    if ctx.golden is not None and ctx.redundant and len(ctx.plan.faults) == 1:
+        f = ctx.plan.faults[0]
+        masked = catalogue.get(f.cls).masked
+        single = f.target.node not in ("*", "world", "bus")
+        identical = ctx.run.truth_bytes == ctx.golden.truth_bytes
+        result["truth_identical"] = identical
+        dev = tracking(ctx)
+        result["tracking"] = dev
+        if single and masked == "bit_identical" and not identical:
+            verdict = "fail"
+            result["why"] = "a masked single-replica fault must leave the truth bit-identical"
+        elif single and masked == "tracking" and any(dev[k] > TRACKING[k] for k in TRACKING):
+            verdict = "fail"
+            result["why"] = f"beyond the tracking bounds {TRACKING}"
+    result["verdict"] = verdict
+    return result

@@ -1,0 +1,164 @@
+# SPDX-License-Identifier: Apache-2.0
+"""What a run left in its run directory, as the oracles read it: each node's SKE trace, the
+bus trace (every frame, decoded where the oracles need it), the world's events and truth, the
+DDS agents' traces, and the modules the nodes ran. Read once, lazily."""
+
+from __future__ import annotations
+
+import functools
+import json
+from collections import defaultdict
+from pathlib import Path
+from typing import Any
+
+import cantools
+
+from ima import paths
+
+_FCS_STATUS_BASE = 0x8B00960  # FCS_STATUS_A; B, C differ in the two redundancy bits
+
+
+def read_jsonl(path: Path) -> list[dict]:
+    out = []
+    try:
+        with open(path, encoding="utf-8") as f:
+            for line in f:
+                try:
+                    rec = json.loads(line)
+                except ValueError:
+                    continue  # a line cut by a killed writer
+                if isinstance(rec, dict):
+                    out.append(rec)
+    except OSError:
+        pass
+    return out
+
+
+@functools.cache
+def _dbc():
+    return cantools.database.load_file(str(paths.repo_root() / "config" / "can" / "rpas.dbc"))
+
+
+def fcs_choices(signal: str) -> dict[int, str]:
+    """The DBC's value table of an FCS_STATUS signal ("FCS_MODE", "FCS_FALLBACK")."""
+    sig = _dbc().get_message_by_name("FCS_STATUS_A").get_signal_by_name(f"{signal}_A")
+    return {int(k): str(v) for k, v in (sig.choices or {}).items()}
+
+
+class RunTraces:
+    """One run directory's records."""
+
+    def __init__(self, run_dir: Path) -> None:
+        self.run_dir = Path(run_dir)
+        try:
+            self.launch = json.loads((self.run_dir / "launch.json").read_text())
+        except (OSError, ValueError):
+            self.launch = {}
+        self.nodes: list[str] = list(self.launch.get("nodes") or [])
+
+    # -- the SKEs ---------------------------------------------------------------------------
+    @functools.cached_property
+    def node_events(self) -> dict[str, list[dict]]:
+        return {n: read_jsonl(self.run_dir / f"{n}.jsonl") for n in self.nodes}
+
+    def node_kind(self, node: str, kind: str) -> list[dict]:
+        return [e for e in self.node_events.get(node, []) if e.get("kind") == kind]
+
+    def windows(self, node: str, partition: str) -> list[tuple]:
+        """(kind, t_ns, frame, window, yielded, yield_t_ns) of the partition's windows."""
+        return [(e["kind"], e["t_ns"], e.get("frame"), e.get("window"), e.get("yielded"),
+                 e.get("yield_t_ns"))
+                for e in self.node_events.get(node, [])
+                if e.get("kind") in ("window_start", "window_end")
+                and e.get("partition") == partition]
+
+    def port_hashes(self, node: str) -> dict[tuple[str, str], list[tuple[int, str]]]:
+        out: dict[tuple[str, str], list[tuple[int, str]]] = defaultdict(list)
+        for e in self.node_kind(node, "port_hash"):
+            out[(e["partition"], e["port"])].append((e["t_ns"], e["hash"]))
+        return out
+
+    def app_messages(self, node: str) -> list[dict]:
+        return self.node_kind(node, "app_message")
+
+    # -- the bus ----------------------------------------------------------------------------
+    @functools.cached_property
+    def can(self) -> list[dict]:
+        return read_jsonl(self.run_dir / "can.jsonl")
+
+    @functools.cached_property
+    def frames(self) -> list[dict]:
+        return [e for e in self.can if e.get("kind") == "can_tx"]
+
+    def frames_of(self, can_id: int) -> list[dict]:
+        return [e for e in self.frames if e.get("id") == can_id]
+
+    def bus_kind(self, *kinds: str) -> list[dict]:
+        return [e for e in self.can if e.get("kind") in kinds]
+
+    def decode(self, frame: dict) -> dict[str, Any]:
+        msg = _dbc().get_message_by_frame_id(frame["id"])
+        return msg.decode(bytes.fromhex(frame["data"]), decode_choices=False)
+
+    @functools.cached_property
+    def fcs_status(self) -> list[tuple[int, int, dict]]:
+        """(t_ns, node index 1..3, decoded FCS_STATUS_x) of every heartbeat on the bus."""
+        out = []
+        for e in self.frames:
+            rci = e["id"] - _FCS_STATUS_BASE
+            if 0 <= rci <= 2:
+                d = {k.rsplit("_", 1)[0]: v for k, v in self.decode(e).items()}
+                out.append((e["t_ns"], rci + 1, d))
+        return out
+
+    # -- the world --------------------------------------------------------------------------
+    @functools.cached_property
+    def world(self) -> list[dict]:
+        return read_jsonl(self.run_dir / "world.jsonl")
+
+    def world_kind(self, kind: str) -> list[dict]:
+        return [e for e in self.world if e.get("kind") == kind]
+
+    @functools.cached_property
+    def truth(self) -> list[dict]:
+        return read_jsonl(self.run_dir / "truth.jsonl")
+
+    @functools.cached_property
+    def truth_bytes(self) -> bytes:
+        try:
+            return (self.run_dir / "truth.jsonl").read_bytes()
+        except OSError:
+            return b""
+
+    # -- the DDS agents ---------------------------------------------------------------------
+    @functools.cached_property
+    def dds(self) -> dict[str, list[dict]]:
+        return {n: read_jsonl(self.run_dir / f"dds{k}.jsonl")
+                for k, n in enumerate(self.nodes, start=1)}
+
+    # -- every injector's `fault` events ----------------------------------------------------
+    @functools.cached_property
+    def fault_events(self) -> list[dict]:
+        """Every `fault` event of the run, whoever wrote it (io's come as app messages
+        `fault FID CLASS STATE DETAIL`)."""
+        out = []
+        for node, events in self.node_events.items():
+            for e in events:
+                if e.get("kind") == "fault":
+                    out.append(dict(e, node=node))
+                elif e.get("kind") == "app_message" and e.get("text", "").startswith("fault "):
+                    parts = e["text"].split(" ", 4)
+                    if len(parts) >= 4:
+                        out.append({"t_ns": e["t_ns"], "node": node, "src": e.get("src"),
+                                    "kind": "fault", "fid": parts[1], "class": parts[2],
+                                    "state": parts[3], "detail": parts[4] if len(parts) > 4
+                                    else ""})
+        out += [e for e in self.can if e.get("kind") == "fault"]
+        out += [e for e in self.world if e.get("kind") == "fault"]
+        for node, events in self.dds.items():
+            out += [dict(e, node=node) for e in events if e.get("kind") == "fault"]
+        return sorted(out, key=lambda e: (e.get("t_ns", 0), str(e.get("fid"))))
+
+    def module(self, node: str) -> Path:
+        return Path(self.launch.get("modules", {}).get(node, self.run_dir / "deploy" /
+                                                            f"{node}.xml"))

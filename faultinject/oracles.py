@@ -18,7 +18,7 @@ ENVELOPE = {"bank_deg": 60.0, "pitch_up_deg": 25.0, "pitch_down_deg": -20.0,
 TRACKING = {"alt_ft": 100.0, "airspeed_kt": 15.0, "heading_deg": 15.0}
 
 
-def _targets(inj: Injection) -> set[tuple[str, str | None]]:
+def direct_targets(inj: Injection) -> set[tuple[str, str | None]]:
     """(node, partition) the fault acts on directly; partition None: every one of the node."""
     f = inj.fault
     if f.target.partition is not None:
@@ -30,7 +30,7 @@ def _targets(inj: Injection) -> set[tuple[str, str | None]]:
 
 def _excluded(ctx: Context, node: str, partition: str) -> bool:
     return any((n, p) in ((node, partition), (node, None))
-               for inj in ctx.plan.injections for n, p in _targets(inj))
+               for inj in ctx.plan.injections for n, p in direct_targets(inj))
 
 
 def temporal_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
@@ -112,7 +112,7 @@ def data_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
     t_first = min((c.t_ns for c in conf if c.t_ns is not None), default=None)
     origins = set()
     for inj in ctx.plan.injections:
-        origins |= _targets(inj) or ({(inj.node, "io")} if inj.node in ctx.node_names
+        origins |= direct_targets(inj) or ({(inj.node, "io")} if inj.node in ctx.node_names
                                      else {("world", None)})
     downstream = _downstream(ctx, origins)
     t_div = _truth_divergence(ctx)

@@ -14,6 +14,7 @@ from faultinject.plan import Plan
 from ima import paths
 from ima.deploy import System
 from ima.deploy.model import VOTING_AXES, canbus_socket_name, dds_socket_name
+from ima.errors import ImaError
 from ima.launch.options import LaunchOptions, binary
 
 
@@ -72,6 +73,8 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
                   "--vote-offset", f"{float(v['offset_s']):g}",
                   "--vote-period", f"{system.major_frame_s:g}"]
     world += faults.world
+    switches = test_switches(opts.test_switches, names)
+    world += switches.get("world", [])
     out = RunPlan(sock_dir=sock_dir, bus=bus, world=world)
 
     for node in names:
@@ -92,5 +95,20 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
             "--node-index", str(k), "--partition-path", partition_path(opts.partition_path),
             "--trace", str(run_dir / f"{node}.jsonl"), "--stats", str(run_dir / f"{node}.json"),
             "-q", *(["--trace-port-hashes"] if opts.port_hashes else []),
-            *faults.ske.get(node, []), "--", str(modules[node])]
+            *faults.ske.get(node, []), *switches.get(node, []), "--", str(modules[node])]
+    return out
+
+
+def test_switches(texts: list[str], nodes: list[str]) -> dict[str, list[str]]:
+    """Test-only switches ("ske:NAME", "ske@node2:NAME", "world:NAME") as the words of each
+    component: node name or "world" -> ["--test-switch", NAME, ...]."""
+    out: dict[str, list[str]] = {}
+    for text in texts:
+        where, sep, name = text.partition(":")
+        comp, _, node = where.partition("@")
+        if not sep or not name or comp not in ("ske", "world") or (node and node not in nodes):
+            raise ImaError(f"--test-switch {text!r}: expected ske:NAME, ske@NODE:NAME or "
+                           "world:NAME")
+        for target in ([node] if node else nodes) if comp == "ske" else ["world"]:
+            out.setdefault(target, []).extend(["--test-switch", name])
     return out

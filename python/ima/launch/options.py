@@ -48,6 +48,9 @@ class LaunchOptions:
     judge: bool = True
     golden: Path | None = None
     port_hashes: bool = False  # the SKEs trace a hash of every port message (data isolation)
+    # test-only switches that plant a violation an oracle must see: "ske:NAME[=VALUE]" (every
+    # node's SKE), "ske@NODE:NAME[=VALUE]" (one node's), "world:NAME[=VALUE]"
+    test_switches: list[str] = field(default_factory=list)
 
 
 @dataclass

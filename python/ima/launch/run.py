@@ -113,8 +113,9 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None,
             ps.signal_all(signal.SIGTERM)
 
     try:
-        for s in (signal.SIGINT, signal.SIGTERM):
-            previous[s] = signal.signal(s, on_signal)
+        if threading.current_thread() is threading.main_thread():  # (a Dask worker's is not)
+            for s in (signal.SIGINT, signal.SIGTERM):
+                previous[s] = signal.signal(s, on_signal)
         if opts.netns:
             from ima.launch import netns as netns_mod
 

@@ -1,0 +1,135 @@
+# SPDX-License-Identifier: Apache-2.0
+"""One run of a campaign, as a worker flies it (in a process of this machine or on a Dask
+worker: its arguments are plain data): the launch with the run's faults, flown again once if
+the host stalled a partition that was not a target, judged against its golden run, and
+turned into one FARM record (Fault, Activation, Readouts, Measures)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import time
+from pathlib import Path
+
+from ima.launch.options import LaunchOptions
+
+# Not in the deterministic part of a record: what the machine, not the run, decides.
+VOLATILE = ("wall_s", "provenance", "refly", "worker", "run_dir")
+
+
+def system_for(campaign_dir: Path, workload: dict, system: str) -> Path:
+    """The system a workload flies: the campaign's, or its derived one with the stand-in
+    mission feed (written by the runner into campaign_dir/systems/)."""
+    if workload.get("mission_feed"):
+        return campaign_dir / "systems" / f"{workload['name']}.yaml"
+    return Path(system)
+
+
+def options(campaign: dict, run: dict, run_dir: Path, faults: list) -> LaunchOptions:
+    w = campaign["workloads"][run["workload"]]
+    return LaunchOptions(
+        system=system_for(Path(campaign["dir"]), w, campaign["system"]),
+        duration_s=campaign["duration_s"], seed=run["seed"], pilot=Path(w["pilot"]),
+        turbulence=w["turbulence"], wind_kt=w["wind_kt"], run_dir=run_dir, kind="campaign",
+        faults=faults, judge=False, port_hashes=True, test_switches=list(
+            campaign.get("test_switches") or []))
+
+
+def host_stalls(run_dir: Path, targets: set[tuple[str, str]]) -> list[dict]:
+    """CPU-budget overruns of partitions that are not targets of a fault: the RPAS partitions
+    use a tiny part of their budgets, so one that overran was stalled by the host (a preempted
+    virtual CPU, direct reclaim), not by anything under test."""
+    out = []
+    for trace in sorted(run_dir.glob("node*.jsonl")):
+        node = trace.stem
+        with open(trace, encoding="utf-8") as f:
+            for line in f:
+                if '"kind":"overrun"' in line and '"cause":"cpu_budget"' in line:
+                    e = json.loads(line)
+                    if (node, e.get("partition")) not in targets and (node, None) not in targets:
+                        out.append(dict(e, node=node))
+    return out
+
+
+def run_one(campaign: dict, run: dict) -> dict:
+    """Flies and judges one run; returns its record (results.jsonl)."""
+    from faultinject import grammar
+    from faultinject.judge import judge
+    from faultinject.oracles import direct_targets
+    from ima import provenance
+    from ima.deploy import load_system
+    from ima.launch import run as launch_run
+
+    t0 = time.monotonic()
+    cdir = Path(campaign["dir"])
+    run_dir = cdir / "runs" / run["run_id"]
+    golden = cdir / "golden" / campaign["golden_of"][run["run_id"]]
+    faults = [grammar.parse(s, f"f{k}") for k, s in enumerate(run["faults"], start=1)]
+    refly = 0
+    while True:
+        shutil.rmtree(run_dir, ignore_errors=True)
+        opts = options(campaign, run, run_dir, faults)
+        result = launch_run.launch(opts)
+        if result.interrupted:
+            raise KeyboardInterrupt(f"{run['run_id']} interrupted")
+        targets = {t for inj in result.plan.injections for t in direct_targets(inj)} \
+            if result.plan else set()
+        stalls = host_stalls(run_dir, targets)
+        if not stalls or refly >= 2:
+            break
+        refly += 1
+    system = load_system(Path(opts.system))
+    failed = {k: v for k, v in result.returncodes.items()
+              if v not in (0, None) and k.split("/")[0] not in {**result.killed, **result.hung}}
+    j = judge(run_dir, golden, result.plan, system, campaign["duration_s"])
+    measures = {"outcome": j["outcome"],
+                "oracles": {k: v.get("verdict") for k, v in j["oracles"].items()},
+                "oracle_violations": j["oracle_violations"], "known_limit": j["known_limit"]}
+    if failed:
+        measures["oracle_violations"] = sorted(set(measures["oracle_violations"]) | {"processes"})
+        measures["failed_processes"] = failed
+    record = {
+        "run_id": run["run_id"], "group": run["group"], "classes": run["classes"],
+        "workload": run["workload"], "seed": run["seed"], "weight": run["weight"],
+        "fault": {"specs": run["faults"],
+                  "faults": [{"id": f["id"], "class": f["class"], "spec": f["spec"],
+                              "requested_t_s": f["requested_t_s"]} for f in j["faults"]]},
+        "activation": {"confirmed": all(f["applied"] for f in j["faults"]),
+                       "faults": [{"id": f["id"], "applied": f["applied"], "t_s": f["t_s"],
+                                   "evidence": f["evidence"]} for f in j["faults"]]},
+        "readouts": {"faults": [{"id": f["id"], "detected_by": f["detected_by"],
+                                 "latency_ms": f["latency_ms"], "outcome": f["outcome"],
+                                 "expected_outcomes": f["expected_outcomes"]}
+                                for f in j["faults"]],
+                     "degraded": j["degraded"], "truth_identical": j["truth_identical"],
+                     "hm": [{k: e.get(k) for k in ("t_ns", "partition", "error", "level",
+                                                    "action")}
+                            for n in result.nodes for e in _hm(run_dir, n)][:20]},
+        "measures": measures,
+        "oracles": j["oracles"],
+        "refly": refly, "wall_s": round(time.monotonic() - t0, 2),
+        "provenance": provenance.provenance(campaign.get("argv")),
+    }
+    keep = campaign.get("keep_all") or measures["oracle_violations"] or \
+        measures["outcome"] == "undetected_hazardous"
+    record["run_dir"] = str(run_dir) if keep else None
+    if not keep:
+        shutil.rmtree(run_dir, ignore_errors=True)
+    return record
+
+
+def _hm(run_dir: Path, node: str) -> list[dict]:
+    out = []
+    try:
+        with open(run_dir / f"{node}.jsonl", encoding="utf-8") as f:
+            for line in f:
+                if '"kind":"hm"' in line:
+                    out.append(json.loads(line))
+    except OSError:
+        pass
+    return out
+
+
+def deterministic(record: dict) -> dict:
+    """The record without its volatile fields: what two runs of one campaign agree on."""
+    return {k: v for k, v in record.items() if k not in VOLATILE}

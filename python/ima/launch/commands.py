@@ -94,10 +94,17 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
 
 def test_switches(system: System, opts: LaunchOptions) -> dict[tuple[str, str], list[str]]:
     """The run's test switches as arguments of a node's partition (ima deploy adds them to
-    that node's module): --test-wrong-output makes io offset its replica's command."""
+    that node's module): --test-wrong-output makes io offset its replica's command
+    (--test-cmd-bias=AXIS=OFFSET@S). A wrong_output entry whose axis is a whole fault spec,
+    "wrong_output:fid=...,mode=...", reaches that node's io as --fault=SPEC instead (its own
+    times and parameters; the entry's offset and time are not used)."""
     out: dict[tuple[str, str], list[str]] = {}
     io = next((p.name for p in system.partitions if p.name == "io"), None)
     for node, axis, value, t in opts.wrong_output:
-        if io is not None:
+        if io is None:
+            continue
+        if axis.startswith("wrong_output:"):
+            out.setdefault((node, io), []).append(f"--fault={axis}")
+        else:
             out.setdefault((node, io), []).append(f"--test-cmd-bias={axis}={value:g}@{t:g}")
     return out

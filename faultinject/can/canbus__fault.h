@@ -140,8 +140,9 @@ int canbus__fault_cut(struct canbus_wire *w, const struct canbus_wire_frame *f, 
  * its index + 1, or 0. */
 int canbus__fault_corrupt(struct canbus_wire *w, const struct canbus_wire_frame *f,
                           int64_t start_ns, uint16_t *fault);
-/* After the transmission recorded at event ev_index: the receivers that miss it (rx_drop,
- * transceiver_cut) and, when `may_duplicate`, a duplicate to send next. */
+/* After the transmission recorded at event ev_index (a frame, or an error frame): the
+ * receivers that miss it (rx_drop: frames only; transceiver_cut) and, for a frame when
+ * `may_duplicate`, a duplicate to send next. */
 int canbus__fault_after_tx(struct canbus_wire *w, size_t ev_index, bool may_duplicate);
 /* Clears the spells that ended by t_ns (trace events). */
 int canbus__fault_close_spells(struct canbus_wire *w, int64_t t_ns);

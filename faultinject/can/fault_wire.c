@@ -237,7 +237,7 @@ int canbus__fault_after_tx(canbus_wire_t *w, size_t ev_index, bool may_duplicate
             continue;
         if (to != CANBUS_ANY && !w->ctl[to].attached)
             continue;
-        if (f->kind == CANBUS_FAULT_RX_DROP) {
+        if (f->kind == CANBUS_FAULT_RX_DROP && tx.kind == CANBUS_EV_TX) {
             if ((f->limit && f->used >= f->limit) ||
                 (f->match_id != CANBUS_ANY_ID && f->match_id != tx.id))
                 continue;
@@ -249,7 +249,7 @@ int canbus__fault_after_tx(canbus_wire_t *w, size_t ev_index, bool may_duplicate
                 return CANBUS_WIRE_ENOMEM;
         }
     }
-    if (!may_duplicate)
+    if (!may_duplicate || tx.kind != CANBUS_EV_TX)
         return 0;
     canbus_fault_t *dup = canbus_fault_find(w->faults, w->n_faults, CANBUS_FAULT_DUPLICATE,
                                             tx.client, tx.id, t);

@@ -67,7 +67,7 @@ static int out_reserve(canbus_bus_t *b, size_t n)
     return 0;
 }
 
-/* Is the TX event k kept from `client` by a fault (an RX_DROP event after it)? */
+/* Is the TX or ERROR event k kept from `client` by a fault (an RX_DROP event after it)? */
 static bool rx_dropped(const canbus_wire_t *w, size_t k, int client)
 {
     for (size_t j = k + 1; j < w->n_ev; j++) {
@@ -116,7 +116,8 @@ static int deliver(canbus_bus_t *b, int64_t t, bool tick)
                     const canbus_wire_ev_t *e = &w->ev[k];
                     if (e->kind == CANBUS_EV_TX && e->client == c->index && !own)
                         continue;
-                    if (e->kind == CANBUS_EV_TX && k + 1 < w->n_ev && rx_dropped(w, k, c->index))
+                    if ((e->kind == CANBUS_EV_TX || e->kind == CANBUS_EV_ERROR) &&
+                        k + 1 < w->n_ev && rx_dropped(w, k, c->index))
                         continue;
                     if (ev_rec(e, &b->out[n])) {
                         if (e->kind == CANBUS_EV_TX)

@@ -428,6 +428,9 @@ static int error_frame(canbus_wire_t *w, const canbus_wire_frame_t *f, uint64_t 
     if (add_busy(w, b, end))
         return CANBUS_WIRE_ENOMEM;
     w->free_bit = end;
+    /* A receiver whose transceiver is cut does not see the error frame either. */
+    if (w->n_faults && canbus__fault_after_tx(w, w->n_ev - 1, false))
+        return CANBUS_WIRE_ENOMEM;
     if (ctl && ctl->tec > 255)
         canbus__wire_bus_off(w, f->client, end, false);
     return 0;

@@ -48,7 +48,7 @@ enum canbus_ev_kind {
     CANBUS_EV_BUS_ON = 4,  /* the client recovered from bus-off */
     CANBUS_EV_DROP = 5,    /* a frame was discarded before the wire (fault or bus-off) */
     CANBUS_EV_FAULT = 6,   /* a fault applied, cleared or refused (canbus__fault.h) */
-    CANBUS_EV_RX_DROP = 7, /* the TX event just before was not delivered to client `to` */
+    CANBUS_EV_RX_DROP = 7, /* the TX (or ERROR) event before was not delivered to client `to` */
 };
 
 enum canbus_drop_reason { CANBUS_DROP_FAULT = 1, CANBUS_DROP_BUS_OFF = 2 };
@@ -58,7 +58,7 @@ enum canbus_drop_reason { CANBUS_DROP_FAULT = 1, CANBUS_DROP_BUS_OFF = 2 };
 
 /* What happened on the wire, in wire order; end_ns never decreases along the list (but for
  * a FAULT event that clears a spell: it is stamped with the spell's end). RX_DROP events
- * follow the TX event they are about. FAULT: reason = enum canbus_fault_state, id and client
+ * follow the TX or ERROR event they are about (FAULT events may come between). FAULT: reason = enum canbus_fault_state, id and client
  * = the frame it acted on (CANBUS_ANY_ID: none), data[0..3] = what it did in the spell (a
  * count, little-endian) when it clears. */
 typedef struct canbus_wire_ev {

@@ -272,6 +272,31 @@ static void test_transceiver_cut(void)
     CHECK_EQ(st[1], CANBUS_FAULT_CLEARED);
     CHECK_EQ(at[1], 3 * MS);
     canbus_wire_fini(&w);
+
+    /* A cut receiver does not see error frames either; rx_drop is about frames only. */
+    CHECK_EQ(canbus_wire_init(&w, 1000000, 0), 0);
+    for (uint8_t c = 0; c < 3; c++)
+        canbus_wire_attach(&w, c, true);
+    CHECK_EQ(parse("transceiver_cut:fid=c,at=0,client=2", &f, name), 0);
+    CHECK_EQ(canbus_wire_add_fault(&w, &f), 0);
+    CHECK_EQ(parse("rx_drop:fid=r,at=0,client=1", &f, name), 0);
+    CHECK_EQ(canbus_wire_add_fault(&w, &f), 0);
+    CHECK_EQ(parse("can_corrupt:fid=e,at=0,id=0x40,count=1", &f, name), 0);
+    CHECK_EQ(canbus_wire_add_fault(&w, &f), 0);
+    submit(&w, 0, 0x40, 0);
+    CHECK_EQ(canbus_wire_run(&w, 1 * MS), 0);
+    CHECK_EQ(events(&w, CANBUS_EV_ERROR, e, 16), 1);
+    size_t k = (size_t)(e[0] - w.ev);
+    size_t after_error = 0, to_2 = 0;
+    for (size_t i = k + 1; i < w.n_ev && w.ev[i].kind != CANBUS_EV_TX; i++)
+        if (w.ev[i].kind == CANBUS_EV_RX_DROP) {
+            after_error++;
+            to_2 += w.ev[i].to == 2;
+        }
+    CHECK_EQ(after_error, 1);
+    CHECK_EQ(to_2, 1);
+    CHECK_EQ(events(&w, CANBUS_EV_RX_DROP, e, 16), 3); /* the retransmission: to 2 and to 1 */
+    canbus_wire_fini(&w);
 }
 
 static void test_rx_drop(void)

@@ -27,8 +27,8 @@
  * published without inputs, so it is neither waited for nor included, exactly as a real-time
  * agent would answer after its time-out, but without the timing. In emulated time nothing
  * else could end the wait: the nodes run in lockstep, and the node whose sample is late
- * cannot reach a later frame while the others wait. A real sample of a frame already
- * answered (the late one of dds_delay) is stale, as any. */
+ * cannot reach a later frame while the others wait. The real sample of a frame marked lost
+ * (the late one of dds_delay) is stale, whenever it comes. */
 #ifndef AGENT__AGREE_H
 #define AGENT__AGREE_H
 

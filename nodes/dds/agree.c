@@ -49,6 +49,12 @@ static bool put(agree_t *a, unsigned node, uint32_t frame, int64_t t_ns,
         a->stale++;
         return false;
     }
+    /* A frame marked lost stays lost: its late sample must not count for some agents and not
+     * for others, depending on when it came. */
+    if (!own && s->used && s->frame == frame && s->lost && !lost) {
+        a->stale++;
+        return false;
+    }
     s->used = true;
     s->lost = lost;
     s->frame = frame;

@@ -185,6 +185,16 @@ static void test_lost_frames_are_neither_waited_for_nor_included(void)
     agree_build(&a, 7, 0x7, &g);
     CHECK_EQ(g.present, 0x3);
     CHECK_EQ(a.lost, 1);
+    /* a late real sample of frame 7 before the answer does not undo the mark */
+    agree_t b;
+    agree_init(&b, 1, 3);
+    CHECK_EQ(agree_store_lost(&b, 3, 7, 0), 1);
+    store(&b, 3, 7);
+    CHECK_EQ(b.stale, 1);
+    store(&b, 1, 7);
+    store(&b, 2, 7);
+    agree_build(&b, 7, 0x7, &g);
+    CHECK_EQ(g.present, 0x3);
     /* the late real sample of frame 7 comes after the answer: stale, changes nothing */
     uint64_t stale = a.stale;
     store(&a, 3, 7);

@@ -19,11 +19,15 @@ static void usage(FILE *f)
     fputs("usage: ima-dds-node --node K --nodes N --socket PATH --domain D [--config FILE]\n"
           "                    [--realtime] [--xch-timeout-us 2000] [--lease-ms 1000]\n"
           "                    [--deadline-ms 150] [--startup-timeout-ms 20000]\n"
-          "                    [--bind-device lo] [--trace FILE] [--stats FILE] [-q]\n"
+          "                    [--bind-device lo] [--trace FILE] [--stats FILE]\n"
+          "                    [--fault SPEC]... [-q]\n"
           "  --config FILE  Cyclone DDS configuration (default: $IMA_DDS_CONFIG; the shipped\n"
           "                 one is config/dds/cyclonedds-loopback.xml)\n"
           "  --bind-device  interface every DDS socket is bound to (\"\" leaves them as\n"
-          "                 Cyclone made them)\n",
+          "                 Cyclone made them)\n"
+          "  --fault SPEC   dds_drop:fid=ID,at=TIME[,until=TIME][,period=TIME,on=TIME] or\n"
+          "                 dds_delay:...,frames=N: this node's inputs and health are not\n"
+          "                 published, or published N major frames late (faultinject/README.md)\n",
           f);
 }
 
@@ -40,10 +44,10 @@ static bool parse_i64(const char *s, int64_t lo, int64_t hi, int64_t *out)
 
 enum {
     OPT_NODE = 256, OPT_NODES, OPT_SOCKET, OPT_DOMAIN, OPT_CONFIG, OPT_REALTIME, OPT_XCH_TIMEOUT,
-    OPT_LEASE, OPT_DEADLINE, OPT_STARTUP, OPT_BIND, OPT_TRACE, OPT_STATS, OPT_HELP,
+    OPT_LEASE, OPT_DEADLINE, OPT_STARTUP, OPT_BIND, OPT_TRACE, OPT_STATS, OPT_FAULT, OPT_HELP,
 };
 
-static int parse_args(int argc, char **argv, agent_opts_t *o)
+static int parse_args(int argc, char **argv, agent_opts_t *o, dds_faults_t *faults)
 {
     static const struct option longopts[] = {
         {"node", required_argument, NULL, OPT_NODE},
@@ -59,6 +63,7 @@ static int parse_args(int argc, char **argv, agent_opts_t *o)
         {"bind-device", required_argument, NULL, OPT_BIND},
         {"trace", required_argument, NULL, OPT_TRACE},
         {"stats", required_argument, NULL, OPT_STATS},
+        {"fault", required_argument, NULL, OPT_FAULT},
         {"help", no_argument, NULL, OPT_HELP},
         {NULL, 0, NULL, 0},
     };
@@ -69,6 +74,7 @@ static int parse_args(int argc, char **argv, agent_opts_t *o)
                         .startup_timeout_ns = 20000 * 1000000LL,
                         .bind_device = "lo"};
     int c;
+    char why[200];
     opterr = 0;
     while ((c = getopt_long(argc, argv, "q", longopts, NULL)) != -1) {
         const char *bad = NULL;
@@ -123,6 +129,10 @@ static int parse_args(int argc, char **argv, agent_opts_t *o)
             break;
         case OPT_STATS:
             o->stats_path = optarg;
+            break;
+        case OPT_FAULT:
+            if (dds_fault_add(faults, optarg, why, sizeof why) != 0)
+                bad = why;
             break;
         case 'q':
             o->quiet = true;
@@ -352,7 +362,7 @@ int main(int argc, char **argv)
     hold_std_fds();
     agent_t *a = &agent;
     a->listen_fd = a->io_fd = a->sig_fd = a->wake_rd = a->wake_wr = -1;
-    if (parse_args(argc, argv, &a->o) != 0)
+    if (parse_args(argc, argv, &a->o, &a->faults) != 0)
         return 2;
     snprintf(a->node_name, sizeof a->node_name, "node%u", a->o.node);
     a->start_mono_ns = agent_mono_ns();

@@ -21,6 +21,7 @@
 #include <stdio.h>
 
 #include "agent__agree.h"
+#include "agent__fault.h"
 #include "xch/proto.h"
 
 enum { T_INPUTS, T_HEALTH, T_TELEMETRY, T_MISSION, T_COUNT };
@@ -86,6 +87,19 @@ typedef struct {
 
 typedef struct agent agent_t;
 
+/* A publication a dds_delay fault holds back until io hands over frame `release`. */
+typedef struct {
+    int topic; /* T_INPUTS or T_HEALTH */
+    uint32_t release;
+    struct xch_hdr h;
+    union {
+        struct xch_inputs in;
+        struct xch_health health;
+    } p;
+} agent_held_t;
+
+#define AGENT_HELD_MAX 128 /* two topics x DDS_DELAY_MAX_FRAMES, and room */
+
 typedef struct {
     agent_t *agent;
     int topic;
@@ -132,6 +146,12 @@ struct agent {
     bool pend_waited;
     int64_t last_t_ns;         /* emulated time of the latest request (for the trace) */
 
+    /* faults (agent_fault.c): this node's publications they keep back */
+    dds_faults_t faults;
+    agent_held_t held[AGENT_HELD_MAX]; /* a ring, in the order io handed them over */
+    unsigned held_head, held_n;
+    uint64_t withheld, published_late;
+
     /* statistics */
     agent_topic_stats_t ts[T_COUNT];
     uint64_t agreed, waits, timeouts, superseded, bad_datagrams, partial;
@@ -175,9 +195,17 @@ void agent_io_check_pending(agent_t *a, bool timed_out);
 void agent_io_catch_up(agent_t *a);
 void agent_io_shutdown(agent_t *a);
 
+/* agent_fault.c */
+/* Publishes one of io's INPUTS or HEALTH as this node's faults have it: now, late, or not (in
+ * emulated time a withheld INPUTS is published as a lost mark, agent__agree.h); first the
+ * late ones due by its frame. */
+int agent_fault_publish(agent_t *a, int topic, const struct xch_hdr *h, const void *payload);
+
 /* agent_out.c: the trace (one JSON object per line) and the statistics. */
 /* Starts a trace line with the common fields; false (write nothing more) without a trace. */
 bool agent_trace_begin(agent_t *a, const char *kind);
+/* The same, with the emulated time of the event rather than of the latest request. */
+bool agent_trace_begin_at(agent_t *a, const char *kind, int64_t t_ns);
 void agent_trace_end(agent_t *a);
 void agent_trace_simple(agent_t *a, const char *kind);
 /* Writes the nodes of mask as a JSON array member: ,"key":["node1",...] */

@@ -19,7 +19,16 @@
  * that first sample before answering the same frame is a matter of timing, so it counts for
  * nobody. From the next frame on it is waited for as before. The others would otherwise wait
  * for frames a node whose io is down can never publish, and in lockstep emulated time a
- * blocked io stalls its whole node. */
+ * blocked io stalls its whole node.
+ *
+ * Lost frames: an agent whose publications a fault keeps back (dds_drop, dds_delay) in
+ * emulated time publishes, in place of the frame's inputs, a mark that they are lost (a
+ * sample whose wait_mask has AGREE_LOST_MARK set, and nothing else): the frame is then
+ * published without inputs, so it is neither waited for nor included, exactly as a real-time
+ * agent would answer after its time-out, but without the timing. In emulated time nothing
+ * else could end the wait: the nodes run in lockstep, and the node whose sample is late
+ * cannot reach a later frame while the others wait. The real sample of a frame marked lost
+ * (the late one of dds_delay) is stale, whenever it comes. */
 #ifndef AGENT__AGREE_H
 #define AGENT__AGREE_H
 
@@ -29,9 +38,11 @@
 #include "xch/proto.h"
 
 #define AGREE_RING 64 /* frames kept per node: samples more than this behind are stale */
+#define AGREE_LOST_MARK 0x80000000u /* in a published wait_mask: this frame's inputs are lost */
 
 typedef struct {
     bool used;
+    bool lost; /* published as lost: no inputs */
     uint32_t frame;
     int64_t t_ns;
     struct xch_inputs in;
@@ -52,7 +63,7 @@ typedef struct {
     agree_peer_t peer[XCH_MAX_NODES];
     bool answered;
     uint32_t last_answered; /* the latest frame an AGREED was built for */
-    uint64_t stored, stale;
+    uint64_t stored, stale, lost;
 } agree_t;
 
 void agree_init(agree_t *a, unsigned self, unsigned nodes);
@@ -63,6 +74,10 @@ void agree_init(agree_t *a, unsigned self, unsigned nodes);
  * as its resumption after a withdrawal: it shows how far the node has got. */
 bool agree_store(agree_t *a, unsigned node, uint32_t frame, int64_t t_ns,
                  const struct xch_inputs *in);
+
+/* Stores node's mark that its inputs of frame are lost (see above), with the same rules as
+ * agree_store(). */
+bool agree_store_lost(agree_t *a, unsigned node, uint32_t frame, int64_t t_ns);
 
 /* The bits of wait_mask restricted to the system's other nodes. */
 uint32_t agree_mask(const agree_t *a, uint32_t wait_mask);

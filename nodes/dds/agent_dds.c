@@ -558,7 +558,10 @@ static void take_topic(agent_t *a, int t)
                     agent_lat_add(&a->dds_lat, dds_time() - si[i].source_timestamp);
                 struct xch_inputs x;
                 inputs_from_dds(&x, &buf[i].in);
-                agree_store(&a->agree, k, buf[i].in.frame, buf[i].in.t_ns, &x);
+                if (x.wait_mask & AGREE_LOST_MARK) /* a fault keeps that frame back */
+                    agree_store_lost(&a->agree, k, buf[i].in.frame, buf[i].in.t_ns);
+                else
+                    agree_store(&a->agree, k, buf[i].in.frame, buf[i].in.t_ns, &x);
             } else if (t == T_HEALTH) {
                 a->peer[k - 1].deadline_missed = false;
             }

@@ -186,7 +186,7 @@ static void on_inputs(agent_t *a, const struct xch_hdr *h, const struct xch_inpu
     }
     a->last_t_ns = h->t_ns;
     agree_store(&a->agree, a->o.node, h->frame, h->t_ns, in);
-    agent_dds_publish(a, T_INPUTS, h, in);
+    agent_fault_publish(a, T_INPUTS, h, in);
     a->pending = true;
     a->pend_frame = h->frame;
     a->pend_mask = in->wait_mask;
@@ -257,7 +257,7 @@ static void on_dgram(agent_t *a, const unsigned char *buf, long n)
     case XCH_HEALTH: {
         struct xch_health x;
         memcpy(&x, payload, sizeof x);
-        agent_dds_publish(a, T_HEALTH, &h, &x);
+        agent_fault_publish(a, T_HEALTH, &h, &x);
         break;
     }
     case XCH_TELEMETRY: {

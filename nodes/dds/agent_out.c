@@ -40,15 +40,20 @@ void agent_log(agent_t *a, const char *fmt, ...)
 
 /* The trace has no emulated clock of its own: t_ns is the emulated time of the latest
  * request from io (0 before the first), t_wall_ns the wall clock of the event. */
-bool agent_trace_begin(agent_t *a, const char *kind)
+bool agent_trace_begin_at(agent_t *a, const char *kind, int64_t t_ns)
 {
     if (!a->trace)
         return false;
     fprintf(a->trace,
             "{\"t_wall_ns\":%" PRId64 ",\"t_ns\":%" PRId64
             ",\"node\":\"%s\",\"src\":\"dds\",\"kind\":\"%s\"",
-            agent_wall_ns(), a->last_t_ns, a->node_name, kind);
+            agent_wall_ns(), t_ns, a->node_name, kind);
     return true;
+}
+
+bool agent_trace_begin(agent_t *a, const char *kind)
+{
+    return agent_trace_begin_at(a, kind, a->last_t_ns);
 }
 
 void agent_trace_end(agent_t *a)
@@ -162,6 +167,14 @@ int agent_write_stats(agent_t *a)
             a->agreed, a->partial, a->waits, a->timeouts, a->superseded, a->agree.stale,
             a->bad_datagrams, a->io_connections, a->io_disconnects, a->ev_dropped,
             a->bound_sockets);
+    fprintf(f, "\"withheld\":%" PRIu64 ",\"published_late\":%" PRIu64 ",\"lost_marks\":%" PRIu64
+               ",\"faults\":[",
+            a->withheld, a->published_late, a->agree.lost);
+    for (size_t i = 0; i < a->faults.n; i++)
+        fprintf(f, "%s{\"fid\":\"%s\",\"class\":\"%s\",\"frames\":%" PRIu64 "}", i ? "," : "",
+                a->faults.f[i].spec.fid, dds_fault_class(&a->faults.f[i]),
+                a->faults.f[i].total_frames);
+    fputs("],", f);
     write_lat(f, "exchange_latency_us", &a->xch_lat);
     fputc(',', f);
     write_lat(f, "dds_latency_us", &a->dds_lat);

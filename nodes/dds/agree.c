@@ -22,8 +22,8 @@ static const agree_slot_t *find(const agree_t *a, unsigned node, uint32_t frame)
     return s->used && s->frame == frame ? s : NULL;
 }
 
-bool agree_store(agree_t *a, unsigned node, uint32_t frame, int64_t t_ns,
-                 const struct xch_inputs *in)
+static bool put(agree_t *a, unsigned node, uint32_t frame, int64_t t_ns,
+                const struct xch_inputs *in, bool lost)
 {
     agree_peer_t *p = peer(a, node);
     if (!p)
@@ -49,12 +49,35 @@ bool agree_store(agree_t *a, unsigned node, uint32_t frame, int64_t t_ns,
         a->stale++;
         return false;
     }
+    /* A frame marked lost stays lost: its late sample must not count for some agents and not
+     * for others, depending on when it came. */
+    if (!own && s->used && s->frame == frame && s->lost && !lost) {
+        a->stale++;
+        return false;
+    }
     s->used = true;
+    s->lost = lost;
     s->frame = frame;
     s->t_ns = t_ns;
-    s->in = *in;
+    if (lost)
+        memset(&s->in, 0, sizeof s->in);
+    else
+        s->in = *in;
     a->stored++;
+    a->lost += lost;
     return true;
+}
+
+bool agree_store(agree_t *a, unsigned node, uint32_t frame, int64_t t_ns,
+                 const struct xch_inputs *in)
+{
+    return put(a, node, frame, t_ns, in, false);
+}
+
+bool agree_store_lost(agree_t *a, unsigned node, uint32_t frame, int64_t t_ns)
+{
+    /* A node's own inputs are never lost to itself. */
+    return node != a->self && put(a, node, frame, t_ns, NULL, true);
 }
 
 /* Withdrawn from frame: neither waited for nor included (agent__agree.h). */
@@ -94,7 +117,7 @@ void agree_build(agree_t *a, uint32_t frame, uint32_t wait_mask, struct xch_agre
         if (!(m & (1u << (k - 1))))
             continue;
         const agree_slot_t *s = find(a, k, frame);
-        if (!s || (k != a->self && withdrawn_from(&a->peer[k - 1], frame)))
+        if (!s || s->lost || (k != a->self && withdrawn_from(&a->peer[k - 1], frame)))
             continue;
         out->present |= 1u << (k - 1);
         out->in[k - 1] = s->in;

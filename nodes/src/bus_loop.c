@@ -67,6 +67,21 @@ static int out_reserve(canbus_bus_t *b, size_t n)
     return 0;
 }
 
+/* Is the TX or ERROR event k kept from `client` by a fault (an RX_DROP event after it)? */
+static bool rx_dropped(const canbus_wire_t *w, size_t k, int client)
+{
+    for (size_t j = k + 1; j < w->n_ev; j++) {
+        const canbus_wire_ev_t *e = &w->ev[j];
+        if (e->kind == CANBUS_EV_FAULT)
+            continue; /* a fault's own event may come between */
+        if (e->kind != CANBUS_EV_RX_DROP)
+            return false;
+        if (e->to == client || e->to == CANBUS_ANY)
+            return true;
+    }
+    return false;
+}
+
 /* Quantum start: frames that ended at or before t to CAN clients, then TICK to members. The
  * clients that get no TICK are served first: a node's io partition must hold its frames
  * before its SKE, granted the quantum, can run the window that reads them. */
@@ -100,6 +115,9 @@ static int deliver(canbus_bus_t *b, int64_t t, bool tick)
                 for (size_t k = first; k < last; k++) {
                     const canbus_wire_ev_t *e = &w->ev[k];
                     if (e->kind == CANBUS_EV_TX && e->client == c->index && !own)
+                        continue;
+                    if ((e->kind == CANBUS_EV_TX || e->kind == CANBUS_EV_ERROR) &&
+                        k + 1 < w->n_ev && rx_dropped(w, k, c->index))
                         continue;
                     if (ev_rec(e, &b->out[n])) {
                         if (e->kind == CANBUS_EV_TX)
@@ -174,6 +192,19 @@ static void apply_kills(canbus_bus_t *b)
     }
 }
 
+/* A fault whose named target never joined did nothing: the trace says so, at the end. */
+static void refuse_unbound(canbus_bus_t *b)
+{
+    for (size_t i = 0; i < b->o.n_faults && i < b->wire.n_faults; i++) {
+        if (b->wire.faults[i].target != CANBUS_NOBODY)
+            continue;
+        char detail[96];
+        snprintf(detail, sizeof detail, "no CAN client '%s' joined", b->o.faults[i].target_name);
+        canbus__sb_fault(b, &b->line, b->t, i, CANBUS_FAULT_REFUSED, detail);
+        canbus__trace_write(b, &b->line);
+    }
+}
+
 int canbus_bus_run(canbus_bus_t *b)
 {
     int rc = 0;
@@ -219,6 +250,7 @@ int canbus_bus_run(canbus_bus_t *b)
     }
     b->end_wall = canbus__wall_ns();
     canbus__flush_staged(b);
+    refuse_unbound(b);
     canbus__line_head(&b->line, b->t, "bus_stop");
     canbus_sb_str(&b->line, ",\"reason\":\"");
     canbus_sb_str(&b->line, canbus__stop_name(b->stop_reason));

@@ -24,7 +24,8 @@ static void usage(FILE *f)
           "  --trace FILE             JSON-lines trace ('-' for stdout)\n"
           "  --stats FILE             JSON statistics at exit ('-' for stdout)\n"
           "  --max-clients N          connected clients at most (64)\n"
-          "  --fault KIND:KEY=VAL,... arm a fault (see nodes/README.md); repeatable\n"
+          "  --fault SPEC             CLASS:fid=ID,at=TIME[,until=TIME][,period=TIME,on=TIME][,KEY=VALUE]\n"
+          "                           (faultinject/README.md; older KIND:KEY=VALUE too); repeatable\n"
 "  --kill-node N@SECONDS    kill every client of node N (hello.node) at that time; repeatable\n"
           "  --hang-node N@SECONDS    freeze them instead (SIGSTOP): a hung processor; repeatable\n"
           "  --client-order A,B,...   client indices by name (deterministic for racy joins)\n"
@@ -159,9 +160,19 @@ int main(int argc, char **argv)
             f = &o.faults[o.n_faults];
             memset(f, 0, sizeof *f);
             if (canbus_fault_parse(optarg, &f->fault, f->target_name, sizeof f->target_name,
-                                   err, sizeof err))
+                                   err, sizeof err)) {
                 bad = err;
-            else
+                break;
+            }
+            /* An older form names no fault id: it gets cli1, cli2, ... by its place. */
+            if (!f->fault.fid[0])
+                snprintf(f->fault.fid, sizeof f->fault.fid, "cli%zu", o.n_faults + 1);
+            for (size_t k = 0; k < o.n_faults; k++)
+                if (strcmp(o.faults[k].fault.fid, f->fault.fid) == 0) {
+                    snprintf(err, sizeof err, "--fault: fid %s given twice", f->fault.fid);
+                    bad = err;
+                }
+            if (!bad)
                 o.n_faults++;
             break;
         }

@@ -3,6 +3,8 @@
  * welcomed clients (frames, DONE, STOP, FAULT), each checked before it is acted on. */
 #include "canbus__server.h"
 
+#include <inttypes.h>
+#include <stdio.h>
 #include <string.h>
 
 void canbus__reject(canbus_bus_t *b, canbus_client_t *c, const char *reason)
@@ -45,6 +47,28 @@ static void refuse(canbus_bus_t *b, canbus_client_t *c, uint32_t reason, const c
     canbus__send_stop(b, c, reason);
     canbus__flush_queue(b, c);
     canbus__client_leave(b, c, why);
+}
+
+/* Does a fault's target name designate this client? Its own name, if it has the CAN role
+ * (its controller is what faults act on); or a node's name, "node2", for that node's first
+ * CAN client, "node2/io" (a node's SKE, "node2", has no CAN controller). */
+static bool names(const char *target, const canbus_client_t *c)
+{
+    if (!(c->roles & CANBUS_ROLE_CAN))
+        return false;
+    size_t n = strlen(target);
+    return strcmp(target, c->name) == 0 || (strncmp(target, c->name, n) == 0 && c->name[n] == '/');
+}
+
+/* Command-line faults that name this client are bound to its index. */
+static void bind_faults(canbus_bus_t *b, const canbus_client_t *c)
+{
+    for (size_t i = 0; i < b->o.n_faults && i < b->wire.n_faults; i++) {
+        canbus_fault_t *f = &b->wire.faults[i];
+        if (f->target == CANBUS_NOBODY && b->o.faults[i].target_name[0] &&
+            names(b->o.faults[i].target_name, c))
+            f->target = (uint8_t)c->index;
+    }
 }
 
 void canbus__handle_hello(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p, size_t n)
@@ -107,13 +131,7 @@ void canbus__handle_hello(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p,
         canbus_wire_attach(&b->wire, (uint8_t)c->index, true);
         canbus_wire_arm_recovery(&b->wire, (uint8_t)c->index, b->o.recover);
     }
-    /* Command-line faults that name this client are bound to its index. */
-    for (size_t i = 0; i < b->o.n_faults && i < b->wire.n_faults; i++) {
-        canbus_fault_t *f = &b->wire.faults[i];
-        if (f->target == CANBUS_NOBODY && b->o.faults[i].target_name[0] &&
-            strcmp(b->o.faults[i].target_name, c->name) == 0)
-            f->target = (uint8_t)c->index;
-    }
+    bind_faults(b, c);
     canbus_sbuf_t *s = &c->staged;
     canbus__line_head(s, wl.t_ns, "client_join");
     canbus__sb_client(b, s, "name", (uint8_t)c->index);
@@ -141,15 +159,23 @@ void canbus__handle_hello(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p,
 static void handle_fault(canbus_bus_t *b, canbus_client_t *c, const struct canbus_rec *r)
 {
     canbus_fault_t f;
-    if (canbus_fault_from_rec(r, &f) || canbus_wire_add_fault(&b->wire, &f)) {
+    if (canbus_fault_from_rec(r, &f)) {
+        canbus__reject(b, c, "bad_fault");
+        return;
+    }
+    /* Faults armed by records are named in the order they came: rec1, rec2, ... */
+    snprintf(f.fid, sizeof f.fid, "rec%" PRIu64, b->faults_armed + 1);
+    if (canbus_wire_add_fault(&b->wire, &f)) {
         canbus__reject(b, c, "bad_fault");
         return;
     }
     b->faults_armed++;
     canbus_sbuf_t *s = &c->staged;
-    canbus__line_head(s, b->t, "fault");
-    canbus_sb_str(s, ",\"fault\":\"");
-    canbus_sb_str(s, canbus_fault_kind_name(f.kind));
+    canbus__line_head(s, b->t, "fault_armed");
+    canbus_sb_str(s, ",\"fid\":");
+    canbus_sb_json_str(s, f.fid, sizeof f.fid);
+    canbus_sb_str(s, ",\"class\":\"");
+    canbus_sb_str(s, canbus_fault_class_name(f.kind));
     canbus_sb_str(s, "\",\"target\":");
     canbus_sb_u64(s, f.target);
     canbus_sb_str(s, ",\"match_id\":");

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The CAN wire model: arbitration, frame timing, error frames, fault confinement, faults. */
+/* The CAN wire model: arbitration, frame timing, error frames, fault confinement; the faults
+ * act through the hooks of faultinject/can/canbus__fault.h. */
 #include "canbus__wire.h"
 
 #include <stdlib.h>
@@ -143,7 +144,7 @@ static void heap_remove_client(canbus_wire_heap_t *h, uint8_t client, uint64_t a
 
 /* ---- events, load ----------------------------------------------------------------------- */
 
-static canbus_wire_ev_t *ev_new(canbus_wire_t *w)
+canbus_wire_ev_t *canbus__wire_ev(canbus_wire_t *w)
 {
     if (w->n_ev == w->cap_ev) {
         /* Keep what the caller has not consumed or not seen (ev_mark) yet. */
@@ -253,9 +254,10 @@ void canbus_wire_arm_recovery(canbus_wire_t *w, uint8_t client, bool recover)
     }
 }
 
-static void drop_frame(canbus_wire_t *w, const canbus_wire_frame_t *f, int64_t at_ns)
+void canbus__wire_drop(canbus_wire_t *w, const canbus_wire_frame_t *f, int64_t at_ns,
+                       uint16_t fault)
 {
-    canbus_wire_ev_t *e = ev_new(w);
+    canbus_wire_ev_t *e = canbus__wire_ev(w);
     w->dropped++;
     if (f->client < CANBUS_WIRE_MAX_CLIENTS) {
         w->ctl[f->client].dropped++;
@@ -269,6 +271,7 @@ static void drop_frame(canbus_wire_t *w, const canbus_wire_frame_t *f, int64_t a
     e->reason = (f->client < CANBUS_WIRE_MAX_CLIENTS && w->ctl[f->client].bus_off)
                     ? CANBUS_DROP_BUS_OFF
                     : CANBUS_DROP_FAULT;
+    e->fault = e->reason == CANBUS_DROP_FAULT ? fault : 0;
     e->id = f->id;
     e->flags = f->flags;
     e->len = f->len;
@@ -276,7 +279,12 @@ static void drop_frame(canbus_wire_t *w, const canbus_wire_frame_t *f, int64_t a
     memcpy(e->data, f->data, 8);
 }
 
-static void enter_bus_off(canbus_wire_t *w, uint8_t client, uint64_t at_bit, bool forced)
+static void drop_bus_off(canbus_wire_t *w, const canbus_wire_frame_t *f, int64_t at_ns)
+{
+    canbus__wire_drop(w, f, at_ns, 0);
+}
+
+void canbus__wire_bus_off(canbus_wire_t *w, uint8_t client, uint64_t at_bit, bool forced)
 {
     canbus_wire_ctl_t *c = &w->ctl[client];
     int64_t at_ns = canbus_wire_bit_ns(w, at_bit);
@@ -285,7 +293,7 @@ static void enter_bus_off(canbus_wire_t *w, uint8_t client, uint64_t at_bit, boo
     w->n_bus_off++;
     c->recover_bit = at_bit + CANBUS_RECOVERY_BITS;
     w->bus_off_events++;
-    canbus_wire_ev_t *e = ev_new(w);
+    canbus_wire_ev_t *e = canbus__wire_ev(w);
     if (e) {
         e->kind = CANBUS_EV_BUS_OFF;
         e->client = client;
@@ -297,50 +305,37 @@ static void enter_bus_off(canbus_wire_t *w, uint8_t client, uint64_t at_bit, boo
     }
     /* A bus-off controller sends nothing: what it had queued is lost; frames requested for
      * later are dropped at their time unless it has recovered by then. */
-    heap_remove_client(&w->ready, client, at_bit, ready_before, w, at_ns, drop_frame);
-    heap_remove_client(&w->future, client, at_bit, future_before, w, at_ns, drop_frame);
+    heap_remove_client(&w->ready, client, at_bit, ready_before, w, at_ns, drop_bus_off);
+    heap_remove_client(&w->future, client, at_bit, future_before, w, at_ns, drop_bus_off);
 }
 
-/* State changes due at or before bit b: recoveries and forced bus-offs. */
-static void apply_due(canbus_wire_t *w, uint64_t b)
+void canbus__wire_bus_on(canbus_wire_t *w, uint8_t client, uint64_t at_bit)
+{
+    canbus_wire_ctl_t *ctl = &w->ctl[client];
+    if (!ctl->bus_off)
+        return;
+    w->n_bus_off--;
+    ctl->bus_off = false;
+    ctl->tec = ctl->rec = 0;
+    canbus_wire_ev_t *e = canbus__wire_ev(w);
+    if (e) {
+        e->kind = CANBUS_EV_BUS_ON;
+        e->client = client;
+        e->state = CANBUS_ERR_ACTIVE;
+        e->id = CANBUS_ANY_ID;
+        e->start_ns = e->end_ns = canbus_wire_bit_ns(w, at_bit);
+    }
+}
+
+/* State changes due at or before bit b: recoveries, then what the faults force. */
+static int apply_due(canbus_wire_t *w, uint64_t b)
 {
     for (unsigned c = 0; w->n_bus_off && c < w->n_ctl; c++) {
         canbus_wire_ctl_t *ctl = &w->ctl[c];
-        if (ctl->bus_off && ctl->recover && ctl->recover_bit <= b) {
-            w->n_bus_off--;
-            ctl->bus_off = false;
-            ctl->tec = ctl->rec = 0;
-            canbus_wire_ev_t *e = ev_new(w);
-            if (e) {
-                e->kind = CANBUS_EV_BUS_ON;
-                e->client = (uint8_t)c;
-                e->state = CANBUS_ERR_ACTIVE;
-                e->id = CANBUS_ANY_ID;
-                e->start_ns = e->end_ns = canbus_wire_bit_ns(w, b);
-            }
-        }
+        if (ctl->bus_off && ctl->recover && ctl->recover_bit <= b)
+            canbus__wire_bus_on(w, (uint8_t)c, b);
     }
-    for (size_t i = 0; i < w->n_faults; i++) {
-        canbus_fault_t *f = &w->faults[i];
-        if (f->kind != CANBUS_FAULT_BUS_OFF || f->applied || f->target == CANBUS_NOBODY)
-            continue;
-        if (canbus_wire_bit_ceil(w, f->from_ns) > b)
-            continue;
-        f->applied = true;
-        for (unsigned c = 0; c < w->n_ctl; c++) {
-            if (f->target != CANBUS_ANY && f->target != c)
-                continue;
-            if (f->target == CANBUS_ANY && !w->ctl[c].attached)
-                continue;
-            canbus_wire_ctl_t *ctl = &w->ctl[c];
-            if (ctl->bus_off)
-                continue;
-            ctl->tec = 256;
-            if (f->recover)
-                ctl->recover = true;
-            enter_bus_off(w, (uint8_t)c, b, true);
-        }
-    }
+    return w->n_faults ? canbus__fault_due(w, b) : 0;
 }
 
 /* The next bit after b at which something may become ready, or UINT64_MAX. */
@@ -354,105 +349,41 @@ static uint64_t next_wake(const canbus_wire_t *w, uint64_t b)
         if (ctl->bus_off && ctl->recover && ctl->recover_bit < t)
             t = ctl->recover_bit;
     }
-    for (size_t i = 0; i < w->n_faults; i++) {
-        const canbus_fault_t *f = &w->faults[i];
-        uint64_t from = canbus_wire_bit_ceil(w, f->from_ns);
-        if (f->kind == CANBUS_FAULT_BUS_OFF && !f->applied && f->target != CANBUS_NOBODY &&
-            from < t)
-            t = from;
-        if (f->kind == CANBUS_FAULT_BABBLE && from > b && from < t &&
-            (f->limit == 0 || f->used < f->limit))
-            t = from;
+    if (w->n_faults) {
+        uint64_t f = canbus__fault_wake(w, b);
+        if (f < t)
+            t = f;
     }
     return t;
 }
 
-static bool in_window(const canbus_fault_t *f, int64_t t)
+int canbus__wire_requeue(canbus_wire_t *w, const canbus_wire_frame_t *f)
 {
-    return t >= f->from_ns && t < f->until_ns;
+    return heap_push(&w->future, f, future_before);
 }
 
-static bool matches(const canbus_fault_t *f, const canbus_wire_frame_t *fr, int64_t t)
-{
-    if (f->limit && f->used >= f->limit)
-        return false;
-    if (f->target == CANBUS_NOBODY || (f->target != CANBUS_ANY && f->target != fr->client))
-        return false;
-    if (f->match_id != CANBUS_ANY_ID && f->match_id != fr->id)
-        return false;
-    return in_window(f, t);
-}
-
-static canbus_fault_t *find_fault(canbus_wire_t *w, uint8_t kind, const canbus_wire_frame_t *fr,
-                                  int64_t t)
-{
-    for (size_t i = 0; i < w->n_faults; i++)
-        if (w->faults[i].kind == kind && matches(&w->faults[i], fr, t))
-            return &w->faults[i];
-    return NULL;
-}
-
-/* Moves the frames requested at or before bit b to the arbitration set, applying the drop
- * and delay faults (matched on the request time). */
+/* Moves the frames requested at or before bit b to the arbitration set; the drop and delay
+ * faults act here (on the request time). */
 static int release_due(canbus_wire_t *w, uint64_t b)
 {
     while (w->future.n && w->future.v[0].req_bit <= b) {
         canbus_wire_frame_t f = w->future.v[0];
         heap_pop(&w->future, future_before);
         if (f.client < CANBUS_WIRE_MAX_CLIENTS && w->ctl[f.client].bus_off) {
-            drop_frame(w, &f, canbus_wire_bit_ns(w, b));
+            canbus__wire_drop(w, &f, canbus_wire_bit_ns(w, b), 0);
             continue;
         }
-        canbus_fault_t *flt = find_fault(w, CANBUS_FAULT_DROP, &f, f.req_ns);
-        if (flt) {
-            flt->used++;
-            drop_frame(w, &f, canbus_wire_bit_ns(w, b));
-            continue;
-        }
-        if (!f.delayed && (flt = find_fault(w, CANBUS_FAULT_DELAY, &f, f.req_ns))) {
-            flt->used++;
-            f.delayed = 1;
-            f.req_ns += flt->delay_ns;
-            f.req_bit = canbus_wire_bit_ceil(w, f.req_ns);
-            if (heap_push(&w->future, &f, future_before))
+        if (w->n_faults) {
+            enum canbus_release what;
+            if (canbus__fault_release(w, &f, b, &what))
                 return CANBUS_WIRE_ENOMEM;
-            continue;
+            if (what != CANBUS_RELEASE_PASS)
+                continue;
         }
         if (heap_push(&w->ready, &f, ready_before))
             return CANBUS_WIRE_ENOMEM;
     }
     return 0;
-}
-
-/* The babble frame competing at bit b, if any (lowest key among active babble faults). */
-static canbus_fault_t *babbler(canbus_wire_t *w, uint64_t b, canbus_wire_frame_t *out)
-{
-    canbus_fault_t *best = NULL;
-    int64_t t = canbus_wire_bit_ns(w, b);
-    for (size_t i = 0; i < w->n_faults; i++) {
-        canbus_fault_t *f = &w->faults[i];
-        if (f->kind != CANBUS_FAULT_BABBLE || !in_window(f, t) || f->target == CANBUS_NOBODY)
-            continue;
-        if (f->limit && f->used >= f->limit)
-            continue;
-        if (f->target != CANBUS_ANY && w->ctl[f->target].bus_off)
-            continue;
-        canbus_wire_frame_t c = {0};
-        c.req_ns = t;
-        c.req_bit = b;
-        c.id = f->babble_id;
-        c.flags = f->babble_flags;
-        c.len = f->babble_len;
-        c.client = f->target;
-        c.key = canbus_wire_arb_key(c.id, c.flags);
-        for (unsigned k = 0; k < 8; k++)
-            c.data[k] = (uint8_t)(w->babble_count >> (8 * (k % 4)));
-        if (!best || ready_before(&c, out)) {
-            best = f;
-            *out = c;
-        }
-    }
-    return best;
 }
 
 static void fill_ev(canbus_wire_ev_t *e, const canbus_wire_frame_t *f, uint8_t kind)
@@ -465,17 +396,108 @@ static void fill_ev(canbus_wire_ev_t *e, const canbus_wire_frame_t *f, uint8_t k
     memcpy(e->data, f->data, 8);
 }
 
+/* A corrupted transmission of f at bit b: the error frame, the counters, perhaps bus-off.
+ * Receivers see a CRC error and flag it after the ACK delimiter (ISO 11898-1 §10.11); the
+ * frame stays queued and competes again. */
+static int error_frame(canbus_wire_t *w, const canbus_wire_frame_t *f, uint64_t b, uint16_t fault)
+{
+    uint32_t bits = canbus_wire_frame_bits(f->flags, f->len);
+    canbus_wire_ctl_t *ctl = f->client < CANBUS_WIRE_MAX_CLIENTS ? &w->ctl[f->client] : NULL;
+    uint64_t end = b + bits - CANBUS_EOF_IFS_BITS + CANBUS_ERROR_FRAME_BITS + CANBUS_IFS_BITS +
+                   w->gap_bits;
+    w->error_frames++;
+    for (size_t i = 0; i < w->n_receivers; i++) {
+        canbus_wire_ctl_t *r = &w->ctl[w->receivers[i]];
+        if (w->receivers[i] != f->client && !r->bus_off && r->rec < 255)
+            r->rec++;
+    }
+    if (ctl) {
+        ctl->tec = (uint16_t)(ctl->tec + 8);
+        ctl->tx_err++;
+    }
+    canbus_wire_ev_t *e = canbus__wire_ev(w);
+    if (!e)
+        return CANBUS_WIRE_ENOMEM;
+    fill_ev(e, f, CANBUS_EV_ERROR);
+    e->fault = fault;
+    e->start_ns = canbus_wire_bit_ns(w, b);
+    e->end_ns = canbus_wire_bit_ns(w, end);
+    e->tec = ctl ? ctl->tec : 0;
+    e->state = (uint8_t)(ctl && ctl->tec > 255 ? CANBUS_ERR_BUS_OFF
+                                               : canbus_wire_state(w, f->client));
+    if (add_busy(w, b, end))
+        return CANBUS_WIRE_ENOMEM;
+    w->free_bit = end;
+    /* A receiver whose transceiver is cut does not see the error frame either. */
+    if (w->n_faults && canbus__fault_after_tx(w, w->n_ev - 1, false))
+        return CANBUS_WIRE_ENOMEM;
+    if (ctl && ctl->tec > 255)
+        canbus__wire_bus_off(w, f->client, end, false);
+    return 0;
+}
+
+/* A good transmission of f at bit b, delivered to the receivers. */
+static int transmit(canbus_wire_t *w, const canbus_wire_frame_t *f, uint64_t b, uint16_t fault,
+                    uint8_t reason)
+{
+    uint32_t bits = canbus_wire_frame_bits(f->flags, f->len);
+    uint64_t end = b + bits;
+    canbus_wire_ctl_t *ctl = f->client < CANBUS_WIRE_MAX_CLIENTS ? &w->ctl[f->client] : NULL;
+    if (ctl) {
+        if (ctl->tec)
+            ctl->tec--;
+        ctl->tx_ok++;
+    }
+    for (size_t i = 0; i < w->n_receivers; i++) {
+        canbus_wire_ctl_t *r = &w->ctl[w->receivers[i]];
+        if (w->receivers[i] != f->client && r->rec)
+            r->rec = r->rec > 127 ? 127 : (uint16_t)(r->rec - 1);
+    }
+    canbus_wire_ev_t *e = canbus__wire_ev(w);
+    if (!e)
+        return CANBUS_WIRE_ENOMEM;
+    fill_ev(e, f, CANBUS_EV_TX);
+    e->fault = fault;
+    e->reason = reason;
+    e->start_ns = canbus_wire_bit_ns(w, b);
+    e->end_ns = canbus_wire_bit_ns(w, end);
+    e->tec = ctl ? ctl->tec : 0;
+    e->state = (uint8_t)canbus_wire_state(w, f->client);
+    w->frames++;
+    w->frame_bits += bits;
+    if (add_busy(w, b, end))
+        return CANBUS_WIRE_ENOMEM;
+    w->free_bit = end + w->gap_bits;
+    return 0;
+}
+
 int canbus_wire_run(canbus_wire_t *w, int64_t until_ns)
 {
     uint64_t until_bit = canbus_wire_bit_ceil(w, until_ns);
+    bool faults = w->n_faults > 0;
     while (w->free_bit < until_bit) {
         uint64_t b = w->free_bit;
-        apply_due(w, b);
-        if (release_due(w, b))
+        if (faults && canbus__fault_close_spells(w, canbus_wire_bit_ns(w, b)))
+            return CANBUS_WIRE_ENOMEM;
+        if (apply_due(w, b) || release_due(w, b))
             return CANBUS_WIRE_ENOMEM;
 
+        if (w->dup_pending) {
+            /* A duplicate follows its original at once, without arbitration, as the same
+             * controller's retransmission would. */
+            canbus_wire_frame_t d = w->dup;
+            w->dup_pending = false;
+            if (d.client < CANBUS_WIRE_MAX_CLIENTS && w->ctl[d.client].bus_off)
+                continue;
+            w->duplicated++;
+            if (transmit(w, &d, b, w->dup_fault, CANBUS_TX_DUPLICATE) ||
+                canbus__fault_after_tx(w, w->n_ev - 1, false))
+                return CANBUS_WIRE_ENOMEM;
+            continue;
+        }
+
         canbus_wire_frame_t bab;
-        canbus_fault_t *bf = babbler(w, b, &bab);
+        canbus_fault_t *bf = faults ? canbus__fault_babbler(w, b, &bab) : NULL;
         bool from_ready = w->ready.n && (!bf || ready_before(&w->ready.v[0], &bab));
         if (!from_ready && !bf) {
             uint64_t next = next_wake(w, b);
@@ -484,77 +506,41 @@ int canbus_wire_run(canbus_wire_t *w, int64_t until_ns)
         }
         canbus_wire_frame_t f = from_ready ? w->ready.v[0] : bab;
         int64_t start_ns = canbus_wire_bit_ns(w, b);
-        uint32_t bits = canbus_wire_frame_bits(f.flags, f.len);
-        bool own = f.client < CANBUS_WIRE_MAX_CLIENTS;
-        canbus_wire_ctl_t *ctl = own ? &w->ctl[f.client] : NULL;
-
-        canbus_fault_t *cf = find_fault(w, CANBUS_FAULT_CORRUPT, &f, start_ns);
-        if (cf) {
-            /* Receivers see a CRC error and flag it after the ACK delimiter (ISO 11898-1
-             * §10.11); the frame stays queued and competes again. */
-            cf->used++;
-            uint64_t end = b + bits - CANBUS_EOF_IFS_BITS + CANBUS_ERROR_FRAME_BITS +
-                           CANBUS_IFS_BITS + w->gap_bits;
-            w->error_frames++;
-            for (size_t i = 0; i < w->n_receivers; i++) {
-                canbus_wire_ctl_t *r = &w->ctl[w->receivers[i]];
-                if (w->receivers[i] != f.client && !r->bus_off && r->rec < 255)
-                    r->rec++;
-            }
-            if (ctl) {
-                ctl->tec = (uint16_t)(ctl->tec + 8);
-                ctl->tx_err++;
-            }
-            canbus_wire_ev_t *e = ev_new(w);
-            if (!e)
+        uint16_t fault = 0;
+        if (faults && from_ready) {
+            if (canbus__fault_cut(w, &f, start_ns, &fault))
                 return CANBUS_WIRE_ENOMEM;
-            fill_ev(e, &f, CANBUS_EV_ERROR);
-            e->start_ns = start_ns;
-            e->end_ns = canbus_wire_bit_ns(w, end);
-            e->tec = ctl ? ctl->tec : 0;
-            e->state = (uint8_t)(ctl && ctl->tec > 255 ? CANBUS_ERR_BUS_OFF
-                                                       : canbus_wire_state(w, f.client));
-            if (add_busy(w, b, end))
-                return CANBUS_WIRE_ENOMEM;
-            w->free_bit = end;
-            if (ctl && ctl->tec > 255)
-                enter_bus_off(w, f.client, end, false);
-            continue;
+            if (fault) {
+                heap_pop(&w->ready, ready_before);
+                canbus__wire_drop(w, &f, start_ns, fault);
+                continue;
+            }
         }
-
-        uint64_t end = b + bits;
-        if (from_ready)
+        if (faults) {
+            if (canbus__fault_corrupt(w, &f, start_ns, &fault))
+                return CANBUS_WIRE_ENOMEM;
+            if (fault) {
+                if (error_frame(w, &f, b, fault))
+                    return CANBUS_WIRE_ENOMEM;
+                continue;
+            }
+        }
+        if (from_ready) {
             heap_pop(&w->ready, ready_before);
-        else {
-            bf->used++;
-            w->babble_count++;
+            if (f.client < CANBUS_WIRE_MAX_CLIENTS)
+                w->ctl[f.client].pending--;
+        } else {
+            if (canbus__fault_babbled(w, bf, b))
+                return CANBUS_WIRE_ENOMEM;
+            fault = (uint16_t)(bf - w->faults + 1);
         }
-        if (ctl) {
-            if (ctl->tec)
-                ctl->tec--;
-            ctl->tx_ok++;
-            if (from_ready)
-                ctl->pending--;
-        }
-        for (size_t i = 0; i < w->n_receivers; i++) {
-            canbus_wire_ctl_t *r = &w->ctl[w->receivers[i]];
-            if (w->receivers[i] != f.client && r->rec)
-                r->rec = r->rec > 127 ? 127 : (uint16_t)(r->rec - 1);
-        }
-        canbus_wire_ev_t *e = ev_new(w);
-        if (!e)
+        if (transmit(w, &f, b, fault, 0))
             return CANBUS_WIRE_ENOMEM;
-        fill_ev(e, &f, CANBUS_EV_TX);
-        e->start_ns = start_ns;
-        e->end_ns = canbus_wire_bit_ns(w, end);
-        e->tec = ctl ? ctl->tec : 0;
-        e->state = (uint8_t)canbus_wire_state(w, f.client);
-        w->frames++;
-        w->frame_bits += bits;
-        if (add_busy(w, b, end))
+        if (faults && canbus__fault_after_tx(w, w->n_ev - 1, true))
             return CANBUS_WIRE_ENOMEM;
-        w->free_bit = end + w->gap_bits;
     }
+    if (faults && canbus__fault_close_spells(w, until_ns))
+        return CANBUS_WIRE_ENOMEM;
     return 0;
 }
 
@@ -587,9 +573,11 @@ int canbus_wire_submit(canbus_wire_t *w, int64_t req_ns, uint32_t id, uint8_t fl
 
 int canbus_wire_add_fault(canbus_wire_t *w, const canbus_fault_t *f)
 {
-    if (f->kind < CANBUS_FAULT_DROP || f->kind > CANBUS_FAULT_BUS_OFF)
+    if (f->kind < 1 || f->kind > CANBUS_FAULT_KINDS)
         return CANBUS_WIRE_EINVAL;
     if (f->kind == CANBUS_FAULT_BABBLE && f->babble_len > 8)
+        return CANBUS_WIRE_EINVAL;
+    if (f->period_ns < 0 || (f->period_ns > 0 && (f->on_ns <= 0 || f->on_ns > f->period_ns)))
         return CANBUS_WIRE_EINVAL;
     if (w->n_faults == w->cap_faults) {
         size_t cap = w->cap_faults ? w->cap_faults * 2 : 8;
@@ -599,10 +587,14 @@ int canbus_wire_add_fault(canbus_wire_t *w, const canbus_fault_t *f)
         w->faults = v;
         w->cap_faults = cap;
     }
+    if (w->n_faults >= UINT16_MAX - 1)
+        return CANBUS_WIRE_EFULL; /* events name a fault by a 16-bit index */
     note_client(w, f->target);
-    w->faults[w->n_faults] = *f;
-    w->faults[w->n_faults].used = 0;
-    w->faults[w->n_faults].applied = false;
-    w->n_faults++;
+    canbus_fault_t *g = &w->faults[w->n_faults++];
+    *g = *f;
+    g->used = 0;
+    g->spell = g->last_spell = -1;
+    g->spell_hits = 0;
+    g->forced_spell = -1;
     return 0;
 }

@@ -30,6 +30,9 @@ void canbus__sb_client(canbus_bus_t *b, canbus_sbuf_t *s, const char *key, uint8
 void canbus__staged_reject(canbus_bus_t *b, canbus_client_t *c, const char *reason);
 /* The trace lines of the read phase, in client order. */
 void canbus__flush_staged(canbus_bus_t *b);
+/* A `fault` line (fid, class, target, state, detail) of the bus's fault i into s. */
+void canbus__sb_fault(canbus_bus_t *b, canbus_sbuf_t *s, int64_t t_ns, size_t i, uint8_t state,
+                      const char *detail);
 /* The wire's events since the last call, into the trace. */
 int canbus__write_wire_trace(canbus_bus_t *b);
 

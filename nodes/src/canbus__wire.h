@@ -9,13 +9,12 @@
 #include <stdint.h>
 
 #include "canbus/proto.h"
+#include "canbus__fault.h"
 
-/* Client indices 0..CANBUS_WIRE_MAX_CLIENTS-1. CANBUS_ANY in a fault means every client and,
- * as a sender, the bus's own babbler; CANBUS_NOBODY is a fault target not bound yet. */
+/* Client indices 0..CANBUS_WIRE_MAX_CLIENTS-1 (CANBUS_ANY, CANBUS_NOBODY: canbus__fault.h). */
 #define CANBUS_WIRE_MAX_CLIENTS 250
-#define CANBUS_ANY 0xFFu
-#define CANBUS_NOBODY 0xFEu
-#define CANBUS_ANY_ID 0xFFFFFFFFu
+_Static_assert(CANBUS_FAULT_MAX_INDEX == CANBUS_WIRE_MAX_CLIENTS - 1,
+               "a fault may name every client index and no other");
 
 /* Bits that follow the CRC delimiter in canbus_frame_bits(): ACK slot and delimiter are
  * before the error, EOF (7) and the interframe space (3) are not sent by a failed frame. */
@@ -27,30 +26,6 @@
 /* Bus-off recovery: 128 occurrences of 11 consecutive recessive bits (ISO 11898-1 §12.1.4),
  * modelled as that many bit times after the bus-off, whatever the traffic. */
 #define CANBUS_RECOVERY_BITS (128u * 11u)
-
-enum canbus_fault_kind {
-    CANBUS_FAULT_DROP = 1,
-    CANBUS_FAULT_CORRUPT = 2,
-    CANBUS_FAULT_DELAY = 3,
-    CANBUS_FAULT_BABBLE = 4,
-    CANBUS_FAULT_BUS_OFF = 5,
-};
-
-typedef struct canbus_fault {
-    uint8_t kind;      /* enum canbus_fault_kind */
-    uint8_t target;    /* client index, CANBUS_ANY or CANBUS_NOBODY */
-    uint32_t match_id; /* identifier to match, CANBUS_ANY_ID for any */
-    int64_t from_ns;   /* active window [from_ns, until_ns) */
-    int64_t until_ns;  /* INT64_MAX when open-ended */
-    uint32_t limit;    /* drop/corrupt: how many frames at most, 0 = no limit */
-    uint32_t used;     /* how many it has hit */
-    int64_t delay_ns;  /* delay */
-    uint32_t babble_id;   /* babble: identifier */
-    uint8_t babble_flags; /* babble: CANBUS_FRAME_* */
-    uint8_t babble_len;   /* babble: data bytes */
-    bool recover;         /* bus_off: the client recovers after CANBUS_RECOVERY_BITS */
-    bool applied;         /* bus_off: done */
-} canbus_fault_t;
 
 /* A frame waiting for the wire. */
 typedef struct canbus_wire_frame {
@@ -72,20 +47,32 @@ enum canbus_ev_kind {
     CANBUS_EV_BUS_OFF = 3, /* the sender (client) entered bus-off */
     CANBUS_EV_BUS_ON = 4,  /* the client recovered from bus-off */
     CANBUS_EV_DROP = 5,    /* a frame was discarded before the wire (fault or bus-off) */
+    CANBUS_EV_FAULT = 6,   /* a fault applied, cleared or refused (canbus__fault.h) */
+    CANBUS_EV_RX_DROP = 7, /* the TX (or ERROR) event before was not delivered to client `to` */
 };
 
 enum canbus_drop_reason { CANBUS_DROP_FAULT = 1, CANBUS_DROP_BUS_OFF = 2 };
 
-/* What happened on the wire, in wire order; end_ns never decreases along the list. */
+/* TX reason: the frame is a duplicate (can_duplicate). */
+#define CANBUS_TX_DUPLICATE 1
+
+/* What happened on the wire, in wire order; end_ns never decreases along the list (but for
+ * a FAULT event that clears a spell: it is stamped with the spell's end). RX_DROP events
+ * follow the TX or ERROR event they are about (FAULT events may come between). FAULT: reason = enum canbus_fault_state, id and client
+ * = the frame it acted on (CANBUS_ANY_ID: none), data[0..3] = what it did in the spell (a
+ * count, little-endian) when it clears. */
 typedef struct canbus_wire_ev {
     uint8_t kind;   /* enum canbus_ev_kind */
     uint8_t client; /* sender (CANBUS_ANY: the babbler) */
     uint8_t state;  /* sender's enum canbus_err_state after the event */
-    uint8_t reason; /* DROP: enum canbus_drop_reason; BUS_OFF: 1 if forced by a fault */
+    uint8_t reason; /* DROP: enum canbus_drop_reason; BUS_OFF: 1 if forced by a fault; TX:
+                       CANBUS_TX_DUPLICATE; FAULT: enum canbus_fault_state */
     uint16_t tec;   /* sender's transmit error counter after the event */
     uint8_t flags;
     uint8_t len;
     uint32_t id;
+    uint16_t fault; /* the fault that caused it (index + 1), 0 for none */
+    uint8_t to;     /* RX_DROP: the receiver that misses the frame (CANBUS_ANY: every one) */
     int64_t start_ns; /* TX/ERROR: start of frame */
     int64_t end_ns;   /* TX/ERROR: when the wire is free again (interframe space included) */
     uint8_t data[8];
@@ -120,6 +107,10 @@ typedef struct canbus_wire {
     size_t n_receivers;
     canbus_fault_t *faults;
     size_t n_faults, cap_faults;
+    /* can_duplicate: the copy that goes on the wire right after its original */
+    canbus_wire_frame_t dup;
+    bool dup_pending;
+    uint16_t dup_fault;
     /* Events: ev[ev_head..n_ev) not consumed yet, ev[ev_mark..n_ev) not seen yet; the caller
      * moves both forward, the wire moves the list down when it needs room. */
     canbus_wire_ev_t *ev;
@@ -127,7 +118,7 @@ typedef struct canbus_wire {
     uint64_t *win_busy; /* busy bits per 1 s window of bus time */
     size_t n_win;
     uint64_t frames, frame_bits, busy_bits, error_frames, bus_off_events, dropped;
-    uint64_t babble_count;
+    uint64_t babble_count, duplicated, rx_dropped;
 } canbus_wire_t;
 
 /* Frames a client may have waiting for the wire (a controller's transmit queue). */
@@ -169,12 +160,17 @@ enum canbus_err_state canbus_wire_state(const canbus_wire_t *w, uint8_t client);
 void canbus_wire_load(const canbus_wire_t *w, int64_t elapsed_ns, double *overall,
                       double *max_1s);
 
-/* Parses "kind:key=value,..." (nodes/README.md) into f; target names are returned in
- * target_name (empty when the target is an index or any). */
-int canbus_fault_parse(const char *spec, canbus_fault_t *f, char *target_name,
-                       size_t name_size, char *err, size_t err_size);
-const char *canbus_fault_kind_name(uint8_t kind);
-/* Decodes a FAULT record (proto.h). */
-int canbus_fault_from_rec(const struct canbus_rec *r, canbus_fault_t *f);
+/* ---- for the fault injector (faultinject/can/fault_wire.c) ------------------------------ */
+
+/* A new event at the end of the list (zeroed), or NULL without memory. */
+canbus_wire_ev_t *canbus__wire_ev(canbus_wire_t *w);
+/* Discards a frame before the wire at at_ns (a DROP event; fault: index + 1, or 0). */
+void canbus__wire_drop(canbus_wire_t *w, const canbus_wire_frame_t *f, int64_t at_ns,
+                       uint16_t fault);
+/* Puts a client bus-off at bit at_bit (forced: by a fault), or back on. */
+void canbus__wire_bus_off(canbus_wire_t *w, uint8_t client, uint64_t at_bit, bool forced);
+void canbus__wire_bus_on(canbus_wire_t *w, uint8_t client, uint64_t at_bit);
+/* Queues a frame again for its (new) request time. */
+int canbus__wire_requeue(canbus_wire_t *w, const canbus_wire_frame_t *f);
 
 #endif

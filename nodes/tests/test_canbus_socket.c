@@ -446,6 +446,114 @@ static int scenario_bus_off(const char *dir)
     return 0;
 }
 
+/* Every FRAME a CAN-only client got until the STOP, identifiers in got[]. */
+static int frames_until_stop(const client_t *c, uint32_t *got, int max)
+{
+    static struct canbus_rec recs[256];
+    struct canbus_rec stop;
+    int n, k = 0;
+    if (until_tick(c, recs, 256, &n, &stop) != 0 || stop.type != CANBUS_MSG_STOP)
+        return -1;
+    for (int i = 0; i < n; i++)
+        if (recs[i].type == CANBUS_MSG_FRAME && k < max)
+            got[k++] = recs[i].id;
+    return k;
+}
+
+/* Faults of the common grammar on the command line: a duplicate, a receiver that misses one
+ * identifier, a node's transceiver cut for a spell (named by the node), a target that never
+ * joins; what each client receives and what the trace says. */
+static int scenario_new_faults(const char *dir)
+{
+    char sock[256], trace[256];
+    snprintf(sock, sizeof sock, "%s/bus4.sock", dir);
+    snprintf(trace, sizeof trace, "%s/trace4.jsonl", dir);
+    char *argv[] = {(char *)bus_path, "--socket", sock, "--lockstep-clients", "1",
+                    "--quantum-us", "1000", "--end-ns", "6000000", "--trace", trace,
+                    "--fault", "can_duplicate:fid=dup,at=0,client=a,id=0x100,count=1",
+                    "--fault", "rx_drop:fid=rx,at=0,client=c,id=0x200",
+                    "--fault", "transceiver_cut:fid=cut,at=2ms,until=4ms,client=node9",
+                    "--fault", "can_drop:fid=ghost,at=0,client=nobody", "-q", NULL};
+    pid_t pid = start_bus(argv, sock);
+    client_t a, b, c, ske, io;
+    struct canbus_rec got[64], tick;
+    int n;
+    REQUIRE(join(&b, sock, "b", CANBUS_ROLE_CAN) == 0);
+    REQUIRE(join(&c, sock, "c", CANBUS_ROLE_CAN) == 0);
+    REQUIRE(join(&ske, sock, "node9", 0) == 0); /* no controller: the node's io is meant */
+    REQUIRE(join(&io, sock, "node9/io", CANBUS_ROLE_CAN) == 0);
+    REQUIRE(join(&a, sock, "a", CANBUS_ROLE_CAN | CANBUS_ROLE_LOCKSTEP) == 0);
+    for (int64_t t = 1000000; t <= 6000000; t += 1000000) {
+        REQUIRE(until_tick(&a, got, 64, &n, &tick) == 0);
+        if (tick.type == CANBUS_MSG_STOP)
+            break;
+        struct canbus_rec io_frame = frame(0x300 + (uint32_t)(t / 1000000 - 1), 0, 8, 0);
+        if (t == 1000000) {
+            /* the duplicated 0x100, 0x200 that c must not get, node9/io's 0x300 */
+            sendrecs(&io, &io_frame, 1);
+            struct canbus_rec q[] = {frame(0x100, 0, 8, 0), frame(0x200, 0, 8, 100000), done(t)};
+            sendrecs(&a, q, 3);
+        } else if (t == 3000000 || t == 5000000) {
+            /* [2, 3 ms): node9/io is cut, both ways; [4, 5 ms): it is back */
+            sendrecs(&io, &io_frame, 1);
+            struct canbus_rec q[] = {frame(0x1FF + (uint32_t)(t / 1000000 - 1), 0, 8, t - 1000000),
+                                     done(t)};
+            sendrecs(&a, q, 2);
+        } else {
+            struct canbus_rec d = done(t);
+            sendrecs(&a, &d, 1);
+        }
+    }
+    uint32_t ids[32];
+    /* b: everything, the duplicate twice */
+    static const uint32_t want_b[] = {0x100, 0x100, 0x200, 0x300, 0x201, 0x203, 0x304};
+    CHECK_EQ(frames_until_stop(&b, ids, 32), 7);
+    for (int i = 0; i < 7; i++)
+        CHECK_EQ(ids[i], want_b[i]);
+    /* c: not 0x200 (rx_drop matches one identifier: 0x201 and 0x203 come) */
+    static const uint32_t want_c[] = {0x100, 0x100, 0x300, 0x201, 0x203, 0x304};
+    CHECK_EQ(frames_until_stop(&c, ids, 32), 6);
+    for (int i = 0; i < 6; i++)
+        CHECK_EQ(ids[i], want_c[i]);
+    /* node9/io: nothing during its cut (0x201), its own 0x302 never went out */
+    static const uint32_t want_io[] = {0x100, 0x100, 0x200, 0x203};
+    CHECK_EQ(frames_until_stop(&io, ids, 32), 4);
+    for (int i = 0; i < 4; i++)
+        CHECK_EQ(ids[i], want_io[i]);
+    close(a.fd);
+    close(b.fd);
+    close(c.fd);
+    close(ske.fd);
+    close(io.fd);
+    CHECK_EQ(wait_bus(pid), 0);
+
+    static char text[1 << 16];
+    REQUIRE(read_file(trace, text, sizeof text) > 0);
+    CHECK_EQ(count(text, "\"kind\":\"fault\""), 5);
+    CHECK(strstr(text, "{\"t_ns\":0,\"node\":\"canbus\",\"src\":\"canbus\",\"kind\":\"fault\","
+                       "\"fid\":\"dup\",\"class\":\"can_duplicate\",\"target\":\"a\","
+                       "\"state\":\"applied\",\"detail\":\"duplicated 0x100 from a\"}\n"));
+    CHECK(strstr(text, "\"kind\":\"fault\",\"fid\":\"rx\",\"class\":\"rx_drop\","
+                       "\"target\":\"c\",\"state\":\"applied\""));
+    CHECK(strstr(text, "{\"t_ns\":2000000,\"node\":\"canbus\",\"src\":\"canbus\",\"kind\":\"fault\","
+                       "\"fid\":\"cut\",\"class\":\"transceiver_cut\",\"target\":\"node9/io\","
+                       "\"state\":\"applied\""));
+    CHECK(strstr(text, "{\"t_ns\":4000000,\"node\":\"canbus\",\"src\":\"canbus\",\"kind\":\"fault\","
+                       "\"fid\":\"cut\",\"class\":\"transceiver_cut\",\"target\":\"node9/io\","
+                       "\"state\":\"cleared\",\"detail\":\"spell ended after 2 frame(s)\"}\n"));
+    CHECK(strstr(text, "\"kind\":\"fault\",\"fid\":\"ghost\",\"class\":\"can_drop\","
+                       "\"target\":\"nobody\",\"state\":\"refused\","
+                       "\"detail\":\"no CAN client 'nobody' joined\"}\n"));
+    CHECK_EQ(count(text, "\"duplicate\":true,\"fid\":\"dup\""), 1);
+    CHECK_EQ(count(text, "\"kind\":\"can_rx_drop\""), 2);
+    CHECK(strstr(text, "\"kind\":\"can_rx_drop\",\"start_ns\":270000,\"id\":512,"
+                       "\"ext\":false,\"len\":8,\"from\":\"a\",\"client\":4,\"to\":\"c\","
+                       "\"to_client\":1,\"fid\":\"rx\"}\n"));
+    CHECK(strstr(text, "\"kind\":\"can_drop\",\"id\":770,\"ext\":false,\"len\":8,"
+                       "\"from\":\"node9/io\",\"client\":3,\"reason\":\"fault\",\"fid\":\"cut\"}"));
+    return 0;
+}
+
 /* SIGTERM: STOP(SIGNAL) to clients, exit 0. */
 static int scenario_signal(const char *dir)
 {
@@ -494,6 +602,7 @@ int main(int argc, char **argv)
     int na = read_file(t1, a, sizeof a), nb = read_file(t2, b, sizeof b);
     CHECK(na > 0 && na == nb && memcmp(a, b, (size_t)na) == 0);
     scenario_bus_off(dir);
+    scenario_new_faults(dir);
     scenario_signal(dir);
     if (!failures) {
         char cmd[400];

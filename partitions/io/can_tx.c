@@ -28,14 +28,6 @@ static double wrap360(double deg)
 /* The channel's identifiers: A, B, C differ in the redundancy channel bits only. */
 static uint32_t with_channel(uint32_t id_a, unsigned channel) { return (id_a & ~0x3u) | (channel & 0x3u); }
 
-void io_cmd_bias(const io_settings_t *s, int64_t t_ns, rpas_act_cmd_msg_t *cmd)
-{
-    if (s->bias_axis < 0 || t_ns < s->bias_from_ns)
-        return;
-    double *axis[IO_AXES] = {&cmd->elev, &cmd->ail, &cmd->rud, &cmd->thr};
-    *axis[s->bias_axis] += s->bias_value;
-}
-
 static void put(io_frame_t *f, uint32_t id_a, unsigned channel, const uint8_t *data, int len)
 {
     f->id = with_channel(id_a, channel);

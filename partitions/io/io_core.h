@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "canbus/proto.h"
+#include "fi/wrong_output.h"
 #include "rpas/ports.h"
 #include "voter/voter.h"
 #include "xch/proto.h"
@@ -19,6 +20,7 @@
 #define IO_PATH_MAX 108     /* a Unix socket path */
 /* A node name, so that "<node>/io" is a bus client name (CANBUS_NAME_LEN with its NUL). */
 #define IO_NAME_MAX (CANBUS_NAME_LEN - 3)
+#define IO_MAX_FAULTS 4     /* --fault arguments */
 
 /* ---- settings (settings.c) ------------------------------------------------------------- */
 
@@ -33,16 +35,19 @@ typedef struct {
     double vote_threshold[IO_AXES]; /* --vote-thresholds=elev,ail,rud,thr */
     unsigned vote_persist;          /* --vote-persist */
     unsigned membership_misses;     /* --membership-missed-frames */
-    /* --test-cmd-bias=AXIS=OFFSET@SECONDS: a test switch that makes this replica wrong */
-    int bias_axis; /* -1: none; else 0..3 */
-    double bias_value;
-    int64_t bias_from_ns;
+    /* --fault=wrong_output:... (fi/wrong_output.h), repeatable: faults this replica injects
+     * into its own command; --test-cmd-bias=AXIS=OFFSET@SECONDS is one of them, a permanent
+     * bias (fid test-cmd-bias) */
+    fi_wo_t fault[IO_MAX_FAULTS];
+    unsigned n_faults;
 } io_settings_t;
 
-/* Parses argv[1..argc-1]. Every setting but the test switch is required. 0, or -1 with one
- * line in err naming the argument at fault. */
+/* Parses argv[1..argc-1]. Every setting but the faults is required. 0, or -1 with one line in
+ * err naming the argument at fault. */
 int io_settings_parse(io_settings_t *s, int argc, char *const argv[], char *err, size_t errlen);
 const char *io_axis_name(int axis); /* "elev", "ail", "rud", "thr" */
+/* The command's axes with their ranges (the DBC's), as the faults name them. */
+extern const fi_wo_axis_t io_axes[IO_AXES];
 
 /* ---- CAN receive (can_rx.c) -------------------------------------------------------------- */
 
@@ -94,8 +99,26 @@ typedef struct {
     rpas_nav_msg_t nav;
 } io_outputs_t;
 
-/* Applies the test switch (if set and due at t) to the command. */
-void io_cmd_bias(const io_settings_t *s, int64_t t_ns, rpas_act_cmd_msg_t *cmd);
+/* ---- faults (faults.c) ------------------------------------------------------------------- */
+
+/* Where each of io's faults is in its spells. */
+typedef struct {
+    fi_wo_state_t wo[IO_MAX_FAULTS];
+} io_fault_state_t;
+
+/* The lines to report (REPORT_APPLICATION_MESSAGE), in order. */
+typedef struct {
+    unsigned n;
+    char line[2 * IO_MAX_FAULTS][FI_WO_REPORT_MAX];
+} io_fault_reports_t;
+
+void io_faults_init(io_fault_state_t *st);
+/* io's faults at t (the time of its transmission): the command as they make it (cmd NULL when
+ * there is none this frame) and the reports due ("fault <fid> wrong_output applied ..."). */
+void io_cmd_faults(const io_settings_t *s, io_fault_state_t *st, int64_t t_ns,
+                   rpas_act_cmd_msg_t *cmd, io_fault_reports_t *out);
+
+/* ---- CAN transmit, continued ----------------------------------------------------------- */
 /* The frames of major frame `frame` on redundancy channel `channel`: ACT_CMD_x, FCS_STATUS_x,
  * and every IO_NAV_EVERY frames NAV_POS_x and NAV_DATA_x. Values are clamped to the DBC's
  * ranges (NaN to the neutral value in range). `sent_cmd` gets the command as the others

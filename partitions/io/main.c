@@ -32,6 +32,8 @@ static struct {
     uint32_t frame_no;      /* major frame of the current rx */
     uint32_t tx_frame;      /* tx cycles so far */
     uint32_t last_fcs_mode; /* for the node's health on DDS */
+    io_fault_state_t faults; /* its --fault arguments, in their spells */
+    io_fault_reports_t fault_reports;
     SAMPLING_PORT_ID_TYPE port[IO_PORT_COUNT];
 } io;
 
@@ -214,8 +216,9 @@ static void tx_process(void)
             o.have_cmd = read_port(IO_PORT_ACT_CMD_IN, &o.cmd);
             o.have_status = read_port(IO_PORT_FCS_STATUS_IN, &o.status);
             o.have_nav = read_port(IO_PORT_NAV_IN, &o.nav);
-            if (o.have_cmd)
-                io_cmd_bias(&io.cfg, t, &o.cmd);
+            io_cmd_faults(&io.cfg, &io.faults, t, o.have_cmd ? &o.cmd : NULL, &io.fault_reports);
+            for (unsigned i = 0; i < io.fault_reports.n; i++)
+                rpas_report("%s", io.fault_reports.line[i]);
             if (o.have_status)
                 io.last_fcs_mode = o.status.mode;
             io_frame_t f[IO_TX_MAX_FRAMES];
@@ -261,9 +264,14 @@ int main(int argc, char *argv[])
     if (io_red_init(&io.red, &io.cfg) != 0)
         return fail("voting settings", INVALID_CONFIG);
     io.xch_on = io.cfg.n_nodes > 1;
-    if (io.cfg.bias_axis >= 0)
-        rpas_report("io: test switch: %s command offset by %g from %g s", io_axis_name(io.cfg.bias_axis),
-                    io.cfg.bias_value, (double)io.cfg.bias_from_ns / 1e9);
+    io_faults_init(&io.faults);
+    for (unsigned k = 0; k < io.cfg.n_faults; k++) {
+        char what[80];
+        fi_wo_describe(&io.cfg.fault[k], what, sizeof what);
+        rpas_report("io: armed fault %s (wrong_output %s, %s from %g s)", io.cfg.fault[k].spec.fid,
+                    what, fi_duration_name(io.cfg.fault[k].spec.duration),
+                    (double)io.cfg.fault[k].spec.at_ns / 1e9);
+    }
     RETURN_CODE_TYPE rc;
     for (int p = 0; p < IO_PORT_COUNT; p++) {
         const rpas_port_spec_t *s = &io_port_spec[p];

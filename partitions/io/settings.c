@@ -10,9 +10,10 @@
 
 #include "io_core.h"
 
-static const char *const axis_names[IO_AXES] = {"elev", "ail", "rud", "thr"};
+/* The ranges io clamps each axis to before encoding it (the DBC's). */
+const fi_wo_axis_t io_axes[IO_AXES] = {{"elev", -1, 1}, {"ail", -1, 1}, {"rud", -1, 1}, {"thr", 0, 1}};
 
-const char *io_axis_name(int axis) { return axis >= 0 && axis < IO_AXES ? axis_names[axis] : "?"; }
+const char *io_axis_name(int axis) { return axis >= 0 && axis < IO_AXES ? io_axes[axis].name : "?"; }
 
 static int bad(char *err, size_t errlen, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 static int bad(char *err, size_t errlen, const char *fmt, ...)
@@ -87,25 +88,40 @@ static bool parse_thresholds(const char *text, double out[IO_AXES])
     return true;
 }
 
-/* AXIS=OFFSET@SECONDS */
-static bool parse_bias(const char *text, io_settings_t *s)
+/* One --fault: a wrong_output fault with a fault id of its own. */
+static bool add_fault(const char *text, io_settings_t *s, char *why, size_t whylen)
+{
+    if (s->n_faults == IO_MAX_FAULTS) {
+        snprintf(why, whylen, "more than %d faults", IO_MAX_FAULTS);
+        return false;
+    }
+    fi_wo_t *f = &s->fault[s->n_faults];
+    if (fi_wo_parse(text, io_axes, IO_AXES, f, why, whylen) != 0)
+        return false;
+    for (unsigned k = 0; k < s->n_faults; k++)
+        if (!strcmp(s->fault[k].spec.fid, f->spec.fid)) {
+            snprintf(why, whylen, "fault id %s given twice", f->spec.fid);
+            return false;
+        }
+    s->n_faults++;
+    return true;
+}
+
+/* --test-cmd-bias=AXIS=OFFSET@SECONDS: the older test switch, a permanent bias from SECONDS. */
+static bool parse_bias(const char *text, io_settings_t *s, char *why, size_t whylen)
 {
     const char *eq = strchr(text, '=');
     if (!eq)
         return false;
-    int axis = -1;
-    for (int i = 0; i < IO_AXES; i++)
-        if (strlen(axis_names[i]) == (size_t)(eq - text) && !strncmp(text, axis_names[i], (size_t)(eq - text)))
-            axis = i;
     char *end;
     double value, from;
-    if (axis < 0 || !parse_double(eq + 1, &end, &value) || *end != '@' ||
-        !parse_double(end + 1, &end, &from) || *end || from < 0)
+    if (!parse_double(eq + 1, &end, &value) || *end != '@' || !parse_double(end + 1, &end, &from) ||
+        *end || from < 0)
         return false;
-    s->bias_axis = axis;
-    s->bias_value = value;
-    s->bias_from_ns = (int64_t)llround(from * 1e9);
-    return true;
+    char spec[FI_SPEC_MAX];
+    snprintf(spec, sizeof spec, "wrong_output:fid=test-cmd-bias,at=%.17gs,mode=bias,axis=%.*s,value=%.17g",
+             from, (int)(eq - text), text, value);
+    return add_fault(spec, s, why, whylen);
 }
 
 enum { OPT_NODE = 1, OPT_INDEX = 2, OPT_NODES = 4, OPT_CANBUS = 8, OPT_DDS = 16, OPT_THRESHOLDS = 32,
@@ -114,8 +130,8 @@ enum { OPT_NODE = 1, OPT_INDEX = 2, OPT_NODES = 4, OPT_CANBUS = 8, OPT_DDS = 16,
 int io_settings_parse(io_settings_t *s, int argc, char *const argv[], char *err, size_t errlen)
 {
     memset(s, 0, sizeof *s);
-    s->bias_axis = -1;
     unsigned seen = 0, index = 0;
+    char why[160] = "bad value";
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         const char *eq = strchr(arg, '=');
@@ -142,13 +158,15 @@ int io_settings_parse(io_settings_t *s, int argc, char *const argv[], char *err,
             bit = OPT_PERSIST, ok = parse_uint(v, 1, 1000, &s->vote_persist);
         else if (IS("--membership-missed-frames"))
             bit = OPT_MISSES, ok = parse_uint(v, 1, 1000, &s->membership_misses);
+        else if (IS("--fault"))
+            bit = 0, ok = add_fault(v, s, why, sizeof why);
         else if (IS("--test-cmd-bias"))
-            bit = 0, ok = parse_bias(v, s);
+            bit = 0, ok = parse_bias(v, s, why, sizeof why);
         else
             return bad(err, errlen, "unknown argument '%.*s'", (int)klen, arg);
 #undef IS
         if (!ok)
-            return bad(err, errlen, "argument '%s': bad value", arg);
+            return bad(err, errlen, "argument '%s': %s", arg, why);
         if (bit & seen)
             return bad(err, errlen, "argument '%.*s' given twice", (int)klen, arg);
         seen |= bit;

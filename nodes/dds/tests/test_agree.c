@@ -172,6 +172,44 @@ static void test_same_publications_same_agreed(void)
     CHECK_EQ(memcmp(&gx, &gy, sizeof gx), 0);
 }
 
+static void test_lost_frames_are_neither_waited_for_nor_included(void)
+{
+    agree_t a;
+    agree_init(&a, 1, 3);
+    store(&a, 1, 7);
+    store(&a, 2, 7);
+    CHECK_EQ(agree_missing(&a, 7, 0x7), 0x4);
+    CHECK_EQ(agree_store_lost(&a, 3, 7, 7 * 50000000LL), 1); /* node 3's inputs of 7: lost */
+    CHECK_EQ(agree_missing(&a, 7, 0x7), 0);
+    struct xch_agreed g;
+    agree_build(&a, 7, 0x7, &g);
+    CHECK_EQ(g.present, 0x3);
+    CHECK_EQ(a.lost, 1);
+    /* a late real sample of frame 7 before the answer does not undo the mark */
+    agree_t b;
+    agree_init(&b, 1, 3);
+    CHECK_EQ(agree_store_lost(&b, 3, 7, 0), 1);
+    store(&b, 3, 7);
+    CHECK_EQ(b.stale, 1);
+    store(&b, 1, 7);
+    store(&b, 2, 7);
+    agree_build(&b, 7, 0x7, &g);
+    CHECK_EQ(g.present, 0x3);
+    /* the late real sample of frame 7 comes after the answer: stale, changes nothing */
+    uint64_t stale = a.stale;
+    store(&a, 3, 7);
+    CHECK_EQ(a.stale - stale, 1);
+    /* the next frame is waited for again, and included */
+    store(&a, 1, 8);
+    store(&a, 2, 8);
+    CHECK_EQ(agree_missing(&a, 8, 0x7), 0x4);
+    store(&a, 3, 8);
+    agree_build(&a, 8, 0x7, &g);
+    CHECK_EQ(g.present, 0x7);
+    /* a node's own inputs are never lost to itself */
+    CHECK_EQ(agree_store_lost(&a, 1, 9, 0), 0);
+}
+
 int main(void)
 {
     test_waits_for_mask_members_only();
@@ -181,6 +219,7 @@ int main(void)
     test_a_node_past_the_frame_is_not_waited_for();
     test_stale_samples_are_dropped();
     test_same_publications_same_agreed();
+    test_lost_frames_are_neither_waited_for_nor_included();
     if (failures) {
         fprintf(stderr, "test_xch_agree: %d check(s) failed\n", failures);
         return 1;

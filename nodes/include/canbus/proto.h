@@ -100,13 +100,16 @@ enum canbus_rec_type {
  *   data[3..4] = the sender's transmit error counter, little-endian.
  *
  * FAULT record (client -> bus), arms a fault in the bus; kinds in `flags`:
- *   1 drop, 2 corrupt, 3 delay, 4 babble, 5 bus_off.
+ *   1 drop, 2 corrupt, 3 delay, 4 babble, 5 bus_off, 6 duplicate, 7 transceiver_cut,
+ *   8 rx_drop (faultinject/can/canbus__fault.h).
  *   id      identifier to match, 0xFFFFFFFF for any (not used by babble and bus_off)
  *   data[0] target client index, 0xFF for any
  *   t_ns    start of the active window; aux = its end (exclusive), aux <= 0 for none.
  *           drop and delay match on a frame's request time, corrupt on its start on the
  *           wire, babble sends while the window is open, bus_off acts once at t_ns.
- *   drop, corrupt: data[1..2] = how many frames at most, little-endian, 0 for no limit
+ *   drop, corrupt, duplicate, rx_drop: data[1..2] = how many frames at most, little-endian,
+ *            0 for no limit (rx_drop: data[0] is the receiver that misses them)
+ *   transceiver_cut: data[0] = the client cut off (not 0xFF), id unused
  *   delay:   data[1..4] = delay in microseconds, little-endian, > 0
  *   babble:  data[1..4] = identifier, little-endian, bit 31 set for 29-bit; data[5] = len;
  *            data[6..7] = how many frames at most, 0 for no limit. The target (0xFF: the bus

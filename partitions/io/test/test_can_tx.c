@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Unit tests of io's CAN transmit: the frames go out on this node's redundancy channel, decode
  * (with the DBC's codecs) to what nav_fcs wrote, clamped to the DBC's ranges; the command the
- * others will see is reported; the test switch offsets one axis from its time on. */
+ * others will see is reported; io's faults make the command wrong in their spells. */
 #include <math.h>
 #include <string.h>
 
@@ -84,21 +84,32 @@ static void test_nothing_to_send(void)
     CHECK(sent[0] == 9); /* untouched without a command */
 }
 
-static void test_bias_switch(void)
+static void test_faults_on_the_command(void)
 {
+    char *argv[] = {"io", "--node=n1", "--node-index=1", "--nodes=1", "--canbus=c", "--dds=d",
+                    "--vote-thresholds=0,0,0,0", "--vote-persist=1", "--membership-missed-frames=1",
+                    "--test-cmd-bias=elev=0.3@0.000001",
+                    "--fault=wrong_output:fid=h,at=2s,until=3s,mode=hardover,axis=thr,value=-1"};
     io_settings_t s;
-    memset(&s, 0, sizeof s);
-    s.bias_axis = 0;
-    s.bias_value = 0.3;
-    s.bias_from_ns = 1000;
-    rpas_act_cmd_msg_t c = {.elev = 0.1};
-    io_cmd_bias(&s, 999, &c);
+    char err[200] = "";
+    CHECK(io_settings_parse(&s, 11, argv, err, sizeof err) == 0);
+    io_fault_state_t st;
+    io_faults_init(&st);
+    io_fault_reports_t rep;
+    rpas_act_cmd_msg_t c = {.elev = 0.1, .thr = 0.6};
+    io_cmd_faults(&s, &st, 999, &c, &rep);
     CHECK_NEAR(c.elev, 0.1, 0);
-    io_cmd_bias(&s, 1000, &c);
+    CHECK(rep.n == 0);
+    io_cmd_faults(&s, &st, 1000, &c, &rep);
     CHECK_NEAR(c.elev, 0.4, 1e-12);
-    s.bias_axis = -1;
-    io_cmd_bias(&s, 5000, &c);
+    CHECK(rep.n == 1 && !strcmp(rep.line[0], "fault test-cmd-bias wrong_output applied mode=bias axis=elev value=0.3"));
+    c = (rpas_act_cmd_msg_t){.elev = 0.1, .thr = 0.6};
+    io_cmd_faults(&s, &st, 2000000000, &c, &rep);
     CHECK_NEAR(c.elev, 0.4, 1e-12);
+    CHECK(c.thr == 0.0); /* hardover to the lower limit */
+    CHECK(rep.n == 1 && strstr(rep.line[0], "fault h wrong_output applied mode=hardover axis=thr to=0"));
+    io_cmd_faults(&s, &st, 3000000000, NULL, &rep); /* no command: still told the spell ended */
+    CHECK(rep.n == 1 && strstr(rep.line[0], "fault h wrong_output cleared"));
 }
 
 static void test_telemetry(void)
@@ -119,7 +130,7 @@ int main(void)
     RUN(test_frames_on_the_node_channel);
     RUN(test_clamped);
     RUN(test_nothing_to_send);
-    RUN(test_bias_switch);
+    RUN(test_faults_on_the_command);
     RUN(test_telemetry);
     return UNIT_RESULT();
 }

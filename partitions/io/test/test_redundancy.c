@@ -19,7 +19,6 @@ static io_settings_t settings(unsigned channel, uint32_t mask, unsigned misses, 
     s.vote_persist = persist;
     for (int i = 0; i < IO_AXES; i++)
         s.vote_threshold[i] = 0.1;
-    s.bias_axis = -1;
     return s;
 }
 

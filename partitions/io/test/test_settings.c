@@ -28,7 +28,7 @@ static void test_good(void)
     CHECK_NEAR(s.vote_threshold[1], 0.2, 0);
     CHECK_NEAR(s.vote_threshold[3], 0.05, 0);
     CHECK(s.vote_persist == 3 && s.membership_misses == 2);
-    CHECK(s.bias_axis == -1);
+    CHECK(s.n_faults == 0);
 }
 
 static void test_sparse_nodes(void)
@@ -42,15 +42,24 @@ static void test_sparse_nodes(void)
     CHECK(s.node_mask == 5 && s.n_nodes == 3 && s.channel == 2);
 }
 
-static void test_bias(void)
+static void test_faults(void)
 {
-    char *argv[] = {"io", GOOD, "--test-cmd-bias=rud=-0.25@12.5"};
+    /* the older test switch is a permanent bias named test-cmd-bias */
+    char *argv[] = {"io", GOOD, "--test-cmd-bias=rud=-0.25@12.5",
+                    "--fault=wrong_output:fid=w2,at=30s,until=40s,mode=random,axis=thr,seed=9",
+                    "--fault=wrong_output:fid=w3,at=1s,period=2s,on=1s,mode=oscillating,axis=ail,"
+                    "value=0.2,period_osc=500ms"};
     io_settings_t s;
-    char err[200];
-    CHECK(parse(&s, err, 10, argv) == 0);
-    CHECK(s.bias_axis == 2);
-    CHECK_NEAR(s.bias_value, -0.25, 0);
-    CHECK(s.bias_from_ns == 12500000000LL);
+    char err[200] = "";
+    CHECK(parse(&s, err, 12, argv) == 0);
+    CHECK(s.n_faults == 3);
+    const fi_wo_t *b = &s.fault[0];
+    CHECK(!strcmp(b->spec.fid, "test-cmd-bias") && b->mode == FI_WO_BIAS && b->axis == 2);
+    CHECK_NEAR(b->value, -0.25, 0);
+    CHECK(b->spec.at_ns == 12500000000LL && b->spec.duration == FI_PERMANENT);
+    CHECK(s.fault[1].mode == FI_WO_RANDOM && s.fault[1].axis == 3 && s.fault[1].seed == 9);
+    CHECK(s.fault[1].lo == 0 && s.fault[1].hi == 1 && s.fault[1].spec.duration == FI_TRANSIENT);
+    CHECK(s.fault[2].spec.duration == FI_INTERMITTENT && s.fault[2].period_osc_ns == 500000000);
     CHECK(!strcmp(io_axis_name(2), "rud"));
 }
 
@@ -76,6 +85,10 @@ static void test_refused(void)
         {"plain", "'plain' is not --NAME=VALUE"},
         {"--test-cmd-bias=yaw=1@2", "--test-cmd-bias"},
         {"--test-cmd-bias=elev=1@-2", "--test-cmd-bias"},
+        {"--fault=wrong_output:fid=a,at=1s,mode=bias,axis=yaw,value=1", "axis=yaw"},
+        {"--fault=wrong_output:fid=a,at=1s,mode=bias,axis=elev", "needs value"},
+        {"--fault=crash:fid=a,at=1s", "not a wrong_output fault"},
+        {"--fault=wrong_output:at=1s,mode=hardover,axis=elev", "fid=ID is required"},
         {"--node=again", "given twice"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
@@ -122,7 +135,7 @@ int main(void)
 {
     RUN(test_good);
     RUN(test_sparse_nodes);
-    RUN(test_bias);
+    RUN(test_faults);
     RUN(test_refused);
     RUN(test_missing);
     return UNIT_RESULT();

@@ -64,7 +64,8 @@ SANITIZED_TARGETS = ("test_config", "test_port_buf", "test_plan", "test_hm",
                      "test_sandbox_policy", "test_canbus_wire", "test_canbus_socket",
                      "nav_fcs_test_nf_math", "nav_fcs_test_nav", "nav_fcs_test_fcs",
                      "io_test_settings", "io_test_can_rx", "io_test_can_tx", "io_test_redundancy",
-                     "test_fi_spec", "test_voter")
+                     "test_fi_spec", "test_voter", "test_canbus_fault", "test_fi_wrong_output",
+                     "test_dds_fault")
 # Built with them because a sanitized test runs it.
 SANITIZED_HELPERS = ("ima-canbus",)
 

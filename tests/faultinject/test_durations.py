@@ -95,3 +95,16 @@ def test_module_reset(fi, run_fi):
     assert all(e["t_ns"] == 100 * MS and run.index(e) > run.index(fault) for e in resets)
     # Once: permanent, but a module that reset at every frame would never run.
     assert len(resets) == 4
+
+
+def test_runs_with_faults_write_identical_traces(fi, run_fi):
+    """Emulated time: faults fire at service calls, at module times; nothing of the host
+    reaches the trace."""
+    faults = ["--fault", "partition_hang:fid=h,at=70ms,until=130ms,partition=faulty",
+              "--fault", "corrupt_output:fid=c,at=100ms,period=100ms,on=50ms,partition=producer,port=SP_STATE",
+              "--fault", "numeric_error:fid=n,at=200ms,period=100ms,on=10ms,partition=consumer,process=sample",
+              "--fault", "memory_exhaustion:fid=m,at=300ms,partition=sink",
+              "--fault", "module_reset:fid=r,at=400ms", "--trace-port-hashes"]
+    a, b = run_fi(fi.module(), 12, *faults), run_fi(fi.module(), 12, *faults)
+    assert a.returncode == 0 and len(a.of("fault")) >= 8, a.context()
+    assert a.trace == b.trace

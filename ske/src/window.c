@@ -76,12 +76,14 @@ static wres_t wait_yield(ske_t *s, ske_part_t *p, int64_t budget_ns, int64_t end
         int64_t wait_ns;
         if (s->time_mode == SKE_TIME_REALTIME) {
             wait_ns = end_mono_ns - now;
-            if (wait_ns <= 0 && !s->sw.eat_next_window) {
+            /* overrun-eats-next-window: wait for the yield, but not for ever (the same bound
+             * as a blocked partition's in emulated mode). */
+            if (wait_ns <= 0 && (!s->sw.eat_next_window || -wait_ns > HANG_MIN_NS)) {
                 *cause = OV_WINDOW_END;
                 return W_OVERRUN;
             }
             if (wait_ns <= 0)
-                wait_ns = 10000000; /* overrun-eats-next-window: wait for the yield */
+                wait_ns = 10000000;
         } else {
             int64_t used = cpu0 >= 0 ? ske__cpu_now(p) - cpu0 : now - t0;
             /* Test switch overrun-eats-next-window: the budget is not enforced. */

@@ -7,26 +7,23 @@
  *   alloc (allocate past its memory limit), socket, fork, kill (another partition's process),
  *   flood (a queuing port), apex (invalid parameters to APEX services), app_error
  *   (RAISE_APPLICATION_ERROR), deadline (miss its deadline), none (behave).
- * "handler" creates an error handler that logs each error and restarts the failed process. */
-#include <signal.h>
+ * "handler" creates an error handler that logs each error and restarts the failed process.
+ * The misbehaviours themselves are faultinject's (fi/partition.h), the ones the fault
+ * injector makes a partition commit. */
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include "ARINC653.h"
+#include "fi/partition.h"
 
 static const char *fault = "none";
 static unsigned at = 5;
 static SAMPLING_PORT_ID_TYPE in_port;
 static QUEUING_PORT_ID_TYPE flood_port;
-static volatile int sink;
-static void *volatile kept;
 static volatile uintptr_t outside = 0x10; /* an address the partition does not own */
-static volatile int depth_limit = 1 << 30; /* deeper than any stack */
 
 static void report(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 #include <stdarg.h>
@@ -41,13 +38,13 @@ static void report(const char *fmt, ...)
     REPORT_APPLICATION_MESSAGE((MESSAGE_ADDR_TYPE)buf, n < (int)sizeof buf ? n : (int)sizeof buf - 1, &rc);
 }
 
-static int recurse(int depth)
+static bool send_flood(void *ctx)
 {
-    volatile char pad[1024];
-    pad[0] = (char)depth;
-    if (depth >= depth_limit)
-        return pad[0];
-    return recurse(depth + 1) + pad[0];
+    static const APEX_BYTE msg[16] = {0};
+    RETURN_CODE_TYPE rc;
+    (void)ctx;
+    SEND_QUEUING_MESSAGE(flood_port, (MESSAGE_ADDR_TYPE)msg, sizeof msg, 0, &rc);
+    return rc == NO_ERROR;
 }
 
 static void misbehave(void)
@@ -55,64 +52,34 @@ static void misbehave(void)
     RETURN_CODE_TYPE rc;
     report("%s: misbehaving now", fault);
     if (strcmp(fault, "segv") == 0) {
-        *(volatile int *)outside = 1;
+        fi_memory_violation();
     } else if (strcmp(fault, "write_port") == 0) {
         /* The destination port's memory is mapped read-only: find it and write to it. */
-        FILE *f = fopen("/proc/self/maps", "r");
-        char line[512];
-        while (f && fgets(line, sizeof line, f)) {
-            unsigned long lo;
-            char perms[5];
-            if (strstr(line, "memfd:ima-") && sscanf(line, "%lx-%*x %4s", &lo, perms) == 2 &&
-                perms[1] == '-') {
-                *(volatile char *)lo = 1;
-            }
-        }
+        void *port = fi_readonly_port_mapping();
+        if (port)
+            fi_write_byte(port);
         report("write_port: no read-only port found");
     } else if (strcmp(fault, "divide") == 0) {
-        volatile int zero = 0, numerator = 1; /* volatile both: "1 / x" compiles to no division */
-        sink = numerator / zero;
+        fi_numeric_error();
     } else if (strcmp(fault, "stack") == 0) {
-        sink = recurse(0);
+        fi_stack_overflow();
     } else if (strcmp(fault, "spin") == 0) {
-        for (;;)
-            sink++;
+        fi_spin_forever();
     } else if (strcmp(fault, "alloc") == 0) {
-        /* Untouched: the limit counts what is allocated, and filling it would take longer
-         * than the window on a slow host. */
-        size_t total = 0;
-        for (;;) {
-            char *p = malloc(1 << 20);
-            if (!p) {
-                report("alloc: malloc returned NULL after %zu MiB", total >> 20);
-                RAISE_APPLICATION_ERROR(APPLICATION_ERROR, (MESSAGE_ADDR_TYPE) "out of memory", 13, &rc);
-                return;
-            }
-            kept = p; /* so that the allocation is not optimised away */
-            total += 1 << 20;
-        }
+        size_t mib = fi_exhaust_memory(0);
+        report("alloc: malloc returned NULL after %zu MiB", mib);
+        RAISE_APPLICATION_ERROR(APPLICATION_ERROR, (MESSAGE_ADDR_TYPE) "out of memory", 13, &rc);
     } else if (strcmp(fault, "socket") == 0) {
-        int s = socket(AF_INET, SOCK_DGRAM, 0);
-        report("socket: got %d", s);
+        long s = fi_illegal_request(false); /* socket() */
+        report("socket: got %ld", s);
     } else if (strcmp(fault, "fork") == 0) {
-        pid_t p = fork();
-        if (p == 0)
-            _exit(0);
-        report("fork: got %d", (int)p);
+        report("fork: got %ld", fi_fork());
     } else if (strcmp(fault, "kill") == 0) {
-        int r = kill(getppid(), SIGKILL); /* the SKE, or any process: not for a partition */
-        report("kill: got %d", r);
+        long r = fi_kill_parent(); /* the SKE, or any process: not for a partition */
+        report("kill: got %ld", r);
     } else if (strcmp(fault, "flood") == 0) {
-        APEX_BYTE msg[16] = {0};
-        int sent = 0, refused = 0;
-        for (int i = 0; i < 100; i++) {
-            SEND_QUEUING_MESSAGE(flood_port, msg, sizeof msg, 0, &rc);
-            if (rc == NO_ERROR)
-                sent++;
-            else
-                refused++;
-        }
-        report("flood: sent %d, refused %d", sent, refused);
+        fi_flood_result_t r = fi_flood(send_flood, NULL, 100, false);
+        report("flood: sent %d, refused %d", r.sent, r.refused);
     } else if (strcmp(fault, "apex") == 0) {
         /* Invalid parameters get return codes; an invalid address is an illegal request. */
         WRITE_SAMPLING_MESSAGE(999, (MESSAGE_ADDR_TYPE) "x", 1, &rc);

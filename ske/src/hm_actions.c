@@ -86,6 +86,12 @@ int ske__hm_handle(ske_t *s, ske_part_t *p, int64_t t, hm_error_t e, hm_state_t 
      * context left that could hang. */
     hm_decision_t d = hm_decide(&s->cfg->hm, &p->cfg->hm, state, e, origin, false,
                                 fatal && ske__alive(p));
+    /* Test switch hm-action: another action than the tables', traced as applied. */
+    hm_action_t forced;
+    if (d.level == HM_LEVEL_PARTITION && ske__switch_hm_action(s, p, &forced)) {
+        d.action = d.partition_action = forced;
+        d.note = NULL;
+    }
     /* A module decision is the module's; what it leaves to the partition is told apart. */
     bool module_note = d.level == HM_LEVEL_MODULE && d.note;
     trace_hm(s, t, p, e, d.level, d.action, state, process, pname, msg, mlen,

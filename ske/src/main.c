@@ -41,8 +41,15 @@ static void usage(FILE *f)
           "  --lockstep SOCKET     advance time in the quanta of the CAN bus at SOCKET (a flight);\n"
           "                        runs until the bus ends the run\n"
           "  --node-index N        this node's number on the bus (redundancy channel), 0..3\n"
+          "  --fault SPEC          inject a fault (repeatable): CLASS:fid=ID,at=TIME[,until=TIME]\n"
+          "                        [,period=TIME,on=TIME],partition=NAME[,process=NAME][,port=NAME]\n"
+          "                        [,value=X], or module_reset:fid=ID,at=TIME (docs/trace-format.md)\n"
+          "  --trace-port-hashes   trace a port_hash event per source port written in a window\n"
+          "  --test-switch NAME[=VALUE]  test only: break an isolation guarantee on purpose\n"
+          "                        (overrun-eats-next-window, hm-action=PARTITION:ACTION,\n"
+          "                        corrupt-port=PARTITION.PORT@TIME)\n"
           "  -q, --quiet           print nothing but errors\n"
-          "exit status: 0 done, 1 run-time failure, 2 usage or invalid module,\n"
+          "exit status: 0 done, 1 run-time failure, 2 usage, invalid module or fault,\n"
           "             3 shut down by the health monitor (module-level SHUTDOWN), 128+N stopped by signal N\n",
           f);
 }
@@ -60,7 +67,8 @@ static int parse_frames(const char *s, int64_t *out)
 
 int main(int argc, char **argv)
 {
-    enum { O_FRAMES = 1000, O_REALTIME, O_EMULATED, O_TRACE, O_STATS, O_NODE, O_SCHEMA, O_PPATH, O_CHECK, O_LOCKSTEP, O_NODE_INDEX };
+    enum { O_FRAMES = 1000, O_REALTIME, O_EMULATED, O_TRACE, O_STATS, O_NODE, O_SCHEMA, O_PPATH, O_CHECK, O_LOCKSTEP, O_NODE_INDEX,
+           O_FAULT, O_PORT_HASHES, O_TEST_SWITCH };
     static const struct option longopts[] = {
         {"frames", required_argument, NULL, O_FRAMES},
         {"realtime", no_argument, NULL, O_REALTIME},
@@ -73,6 +81,9 @@ int main(int argc, char **argv)
         {"check", no_argument, NULL, O_CHECK},
         {"lockstep", required_argument, NULL, O_LOCKSTEP},
         {"node-index", required_argument, NULL, O_NODE_INDEX},
+        {"fault", required_argument, NULL, O_FAULT},
+        {"trace-port-hashes", no_argument, NULL, O_PORT_HASHES},
+        {"test-switch", required_argument, NULL, O_TEST_SWITCH},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
@@ -80,6 +91,15 @@ int main(int argc, char **argv)
     ske_run_opts_t ro = {.frames = -1, .time_mode = -1};
     ske_load_opts_t lo = {.partition_path = getenv("IMA_PARTITION_PATH"), .resolve_executables = true};
     bool check = false;
+    /* Each option's text stays in argv for the whole run. */
+    const char **faults = calloc((size_t)argc, sizeof *faults);
+    const char **switches = calloc((size_t)argc, sizeof *switches);
+    if (!faults || !switches) {
+        fprintf(stderr, "ima-ske: error: out of memory\n");
+        return 1;
+    }
+    ro.faults = faults;
+    ro.test_switches = switches;
     int c;
     while ((c = getopt_long(argc, argv, "qh", longopts, NULL)) != -1) {
         switch (c) {
@@ -104,6 +124,9 @@ int main(int argc, char **argv)
             ro.node_index = (uint32_t)v;
             break;
         }
+        case O_FAULT: faults[ro.n_faults++] = optarg; break;
+        case O_PORT_HASHES: ro.trace_port_hashes = true; break;
+        case O_TEST_SWITCH: switches[ro.n_test_switches++] = optarg; break;
         case O_SCHEMA: lo.schema_dir = optarg; break;
         case O_PPATH: lo.partition_path = optarg; break;
         case O_CHECK: check = true; break;
@@ -126,6 +149,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s\n", line);
         return 2;
     }
+    char err[1024] = "";
+    if (ske_check_options(cfg, &ro, err, sizeof err) != SKE_OK) {
+        fprintf(stderr, "ima-ske: error: %s\n", err);
+        ske_config_free(cfg);
+        return 2;
+    }
     if (check) {
         if (!ro.quiet)
             printf("%s: valid module '%s': %d partitions, %d windows, %d channels, major frame %.6f s\n",
@@ -135,7 +164,6 @@ int main(int argc, char **argv)
         return 0;
     }
 
-    char err[1024] = "";
     ske_t *ske = NULL;
     if (ske_create(cfg, &ro, &ske, err, sizeof err) != SKE_OK) {
         fprintf(stderr, "ima-ske: error: %s\n", err);

@@ -14,6 +14,7 @@
 #include "hm/hm.h"
 #include "ske/plan.h"
 #include "ske/ske.h"
+#include "ske__fault.h"
 #include "ske__stats.h"
 #include "ske__trace.h"
 
@@ -92,6 +93,13 @@ struct ske {
     volatile sig_atomic_t stop_signal;
     volatile sig_atomic_t child_event;
     char exit_reason[16];
+    ske_faults_t faults; /* --fault: injected faults and their bookkeeping */
+    ske_switches_t sw; /* --test-switch */
+    ske_port_hashes_t hashes; /* --trace-port-hashes: the current window's */
+    /* overrun-eats-next-window (emulated mode): until when the last window's partition held
+     * the CPU, its window's end plus the CPU time it used past its budget; a window that
+     * starts earlier starts late. */
+    int64_t cpu_held_until_ns;
     bool on_bus; /* windows wait for the CAN bus's time quanta */
     bool bus_stopped; /* the bus ended the run */
     canbus_client_t bus;
@@ -154,6 +162,39 @@ void ske__trace_mode(ske_t *s, ske_part_t *p, int64_t t, uint32_t mode, uint32_t
 int ske__handle_mode_request(ske_t *s, ske_part_t *p, int64_t t, char *err, size_t errlen);
 void ske__take_schedule_request(ske_t *s, ske_part_t *p, int64_t t);
 void ske__switch_schedule(ske_t *s, ske_slot_t *slot, int to);
+
+/* ---- fault.c: injected faults (--fault) ----------------------------------------------- */
+
+/* Parses and checks every spec against the module; SKE_E_CONFIG with one line in err. */
+int ske__faults_parse(ske_faults_t *fs, const ske_module_cfg_t *m, const char *const *specs,
+                      int n, char *err, size_t errlen);
+/* Arms the partition's faults in its control block, with the bookkeeping so far. */
+void ske__faults_fill_ctl(const ske_t *s, const ske_part_t *p);
+/* A fault event the partition recorded (slot, ske_fault_state_t, what it did): traced, the
+ * bookkeeping updated. False if the slot or state is not one of the partition's. */
+bool ske__fault_event(ske_t *s, ske_part_t *p, int64_t t, int32_t slot, int32_t state,
+                      const char *text, size_t len);
+/* At a window of a partition that is not running: the spells that started are refused. */
+void ske__faults_window_start(ske_t *s, ske_part_t *p, int64_t t);
+/* At a major frame's start: a module reset due. */
+void ske__faults_frame_start(ske_t *s, int64_t t, int64_t frame);
+
+/* ---- switches.c: test switches (--test-switch) ---------------------------------------- */
+
+int ske__switches_parse(ske_switches_t *sw, const ske_module_cfg_t *m, const char *const *given,
+                        int n, char *err, size_t errlen);
+/* One test_switch event per switch, at module start. */
+void ske__switches_trace(ske_t *s);
+/* Before a window: a corrupt-port due. */
+void ske__switches_window_start(ske_t *s, int64_t t);
+/* hm-action: the partition action that replaces the tables' for this partition, if any. */
+bool ske__switch_hm_action(const ske_t *s, const ske_part_t *p, hm_action_t *action);
+
+/* ---- port_hash.c: port hashes (--trace-port-hashes) ----------------------------------- */
+
+void ske__port_hash_grant(ske_t *s, ske_part_t *p);
+void ske__port_hash_queue(ske_t *s, int k, const void *msg, uint32_t len);
+void ske__port_hash_end(ske_t *s, ske_part_t *p, int64_t t);
 
 /* ---- stats_out.c: the module_start event and the statistics file ---------------------- */
 

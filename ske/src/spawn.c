@@ -103,6 +103,7 @@ static void fill_ctl(ske_t *s, ske_part_t *p)
     atomic_store(&c->last_switch_ns, s->last_switch_ns);
     c->duration_ns = p->cfg->duration_in[cur];
     c->period_anchor_ns = p->cfg->anchor_in[cur];
+    ske__faults_fill_ctl(s, p);
     p->grant_seq = 0;
     p->mode_request_seq = 0;
 }

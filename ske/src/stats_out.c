@@ -40,6 +40,7 @@ void ske__trace_module_start(ske_t *s)
             fprintf(s->trace.f, ",\"initial_schedule\":%d", m->schedules[m->initial_schedule].id);
     }
     ske_trace_end(&s->trace);
+    ske__switches_trace(s);
     for (int i = 0; i < m->n_partitions; i++)
         ske__trace_mode(s, &s->parts[i], 0, SKE_MODE_COLD_START, SKE_MODE_IDLE, "power-on");
 }

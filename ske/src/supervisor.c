@@ -22,6 +22,22 @@ bool ske_shut_down_by_hm(const ske_t *ske) { return ske->hm_shutdown; }
 
 /* ---- life cycle ----------------------------------------------------------------------- */
 
+int ske_check_options(const ske_module_cfg_t *cfg, const ske_run_opts_t *opts, char *err,
+                      size_t errlen)
+{
+    ske_faults_t *fs = malloc(sizeof *fs);
+    ske_switches_t sw;
+    if (!fs) {
+        snprintf(err, errlen, "out of memory");
+        return SKE_E_NOMEM;
+    }
+    int rc = ske__faults_parse(fs, cfg, opts->faults, opts->n_faults, err, errlen);
+    if (rc == SKE_OK)
+        rc = ske__switches_parse(&sw, cfg, opts->test_switches, opts->n_test_switches, err, errlen);
+    free(fs);
+    return rc;
+}
+
 int ske_create(const ske_module_cfg_t *cfg, const ske_run_opts_t *opts, ske_t **out, char *err,
                size_t errlen)
 {
@@ -33,6 +49,13 @@ int ske_create(const ske_module_cfg_t *cfg, const ske_run_opts_t *opts, ske_t **
     }
     s->cfg = cfg;
     s->opts = *opts;
+    int rc = ske__faults_parse(&s->faults, cfg, opts->faults, opts->n_faults, err, errlen);
+    if (rc == SKE_OK)
+        rc = ske__switches_parse(&s->sw, cfg, opts->test_switches, opts->n_test_switches, err, errlen);
+    if (rc != SKE_OK) {
+        free(s);
+        return rc;
+    }
     s->cur_partition = -1;
     s->next_schedule = cfg->n_schedules ? cfg->initial_schedule : 0;
     s->time_mode = opts->time_mode >= 0 ? (ske_time_mode_t)opts->time_mode : cfg->time_mode;
@@ -57,7 +80,7 @@ int ske_create(const ske_module_cfg_t *cfg, const ske_run_opts_t *opts, ske_t **
         for (int k = 0; k < SKE_MAX_PORTS; k++)
             p->ports[k].fd = p->ports[k].fd_ro = -1;
     }
-    int rc = ske__setup_ports(s, err, errlen);
+    rc = ske__setup_ports(s, err, errlen);
     if (rc != SKE_OK)
         goto fail;
     for (int i = 0; i < cfg->n_partitions; i++) {
@@ -163,6 +186,8 @@ int ske_run(ske_t *s, char *err, size_t errlen)
             break;
         if (slot.index == 0 && m->n_schedules && s->next_schedule != slot.schedule)
             ske__switch_schedule(s, &slot, s->next_schedule);
+        if (slot.index == 0)
+            ske__faults_frame_start(s, slot.start_ns, slot.frame);
         if (slot.index == 0 && s->hm_reset) {
             rc = ske__hm_module_reset(s, slot.start_ns, err, errlen);
             if (rc != SKE_OK)

@@ -11,7 +11,7 @@
 #include <time.h>
 
 #define SKE_ABI_MAGIC 0x53414d49u /* "IMAS" */
-#define SKE_ABI_VERSION 4u
+#define SKE_ABI_VERSION 5u
 
 #define SKE_NAME_MAX 32 /* names carry at most 31 characters + NUL (ARINC allows 30) */
 #define SKE_MAX_PORTS 64 /* per partition */
@@ -20,6 +20,8 @@
 #define SKE_HM_STATES 4 /* hm_state_t values */
 #define SKE_HM_ERRORS 11 /* hm_error_t values, 0 unused */
 #define SKE_SCHEDULES 8 /* module schedules (ARINC 653 Part 2) */
+#define SKE_FAULT_SLOTS 8 /* injected faults armed per partition (ima-ske --fault) */
+#define SKE_FAULT_ID_MAX 16 /* a fault id with its NUL (faultinject's FI_ID_MAX) */
 
 /* Sandbox flags (ske_ctl_t.sandbox_flags); the policy itself is in ske_sandbox.h. */
 #define SKE_SANDBOX_IO (1u << 0) /* a system partition: it may open files and sockets */
@@ -54,6 +56,8 @@ typedef enum {
     SKE_EV_PROCESS = 4, /* a = process id, b = ske_proc_event_t, text = process name */
     SKE_EV_HM = 5, /* process-level error: a = hm_error_t, b = failed process id,
                       text = ske_hm_text_t (process name, then the message) */
+    SKE_EV_FAULT = 6, /* an injected fault: a = fault slot, b = ske_fault_state_t,
+                         text = what was done */
 } ske_event_kind_t;
 
 typedef enum {
@@ -69,6 +73,54 @@ typedef struct {
     uint32_t len; /* bytes used in text */
     char text[SKE_EVENT_TEXT];
 } ske_event_t;
+
+/* The classes of injected faults a partition commits itself (faultinject's catalogue): the
+ * APEX library's fault hook makes the partition misbehave for real, so that what detects
+ * the misbehaviour (a signal, the SKE's overrun detection, the deadline check, the health
+ * monitor) detects a real event. */
+typedef enum {
+    SKE_FAULT_NONE = 0,
+    SKE_FAULT_PARTITION_CRASH = 1,
+    SKE_FAULT_PARTITION_HANG = 2,
+    SKE_FAULT_CPU_OVERRUN = 3,
+    SKE_FAULT_MEMORY_VIOLATION = 4,
+    SKE_FAULT_NUMERIC_ERROR = 5,
+    SKE_FAULT_STACK_OVERFLOW = 6,
+    SKE_FAULT_ILLEGAL_REQUEST = 7,
+    SKE_FAULT_APPLICATION_ERROR = 8,
+    SKE_FAULT_DEADLINE_MISS = 9,
+    SKE_FAULT_MEMORY_EXHAUSTION = 10,
+    SKE_FAULT_CORRUPT_OUTPUT = 11,
+    SKE_FAULT_STUCK_OUTPUT = 12,
+    SKE_FAULT_QUEUING_FLOOD = 13,
+    SKE_FAULT_FOREIGN_PORT_WRITE = 14,
+    SKE_FAULT_CLASSES = 15,
+} ske_fault_class_t;
+
+/* What became of a fault (SKE_EV_FAULT; the trace's `state`). */
+typedef enum {
+    SKE_FAULT_APPLIED = 1,
+    SKE_FAULT_CLEARED = 2, /* a state fault whose spell ended */
+    SKE_FAULT_REFUSED = 3, /* its spell started but it could not be committed */
+} ske_fault_state_t;
+
+/* One fault armed for the partition. The SKE writes the whole slot before exec; the
+ * bookkeeping (done_spell, active) is the SKE's record of what happened to the fault so far,
+ * kept across restarts of the partition, which learns from it what not to do again. */
+typedef struct {
+    uint32_t cls; /* ske_fault_class_t */
+    uint32_t duration; /* 0 permanent, 1 transient, 2 intermittent (faultinject's fi_duration_t) */
+    int64_t at_ns;
+    int64_t until_ns; /* INT64_MAX: none */
+    int64_t period_ns; /* intermittent */
+    int64_t on_ns; /* intermittent */
+    int64_t value_ns; /* cpu_overrun: the CPU time to spin */
+    int32_t port; /* index in ports[], -1: none */
+    uint32_t active; /* a state fault applied in spell done_spell and not cleared yet */
+    int64_t done_spell; /* the last spell the fault was applied or refused in, -1: none */
+    char process[SKE_NAME_MAX]; /* the process that commits it; "": whichever runs */
+    char fid[SKE_FAULT_ID_MAX];
+} ske_fault_slot_t;
 
 /* One of the partition's own ports. The SKE fills it before exec; `fd` is the partition's
  * descriptor of the port memory (read-only for destination ports). */
@@ -162,6 +214,12 @@ typedef struct {
     _Atomic uint32_t schedule_request_seq; /* partition: incremented per request */
     _Atomic uint32_t schedule_request_ack; /* SKE: the request it has taken */
     uint32_t pad1;
+
+    /* Injected faults (ima-ske --fault), written by the SKE before exec. */
+    uint32_t n_faults;
+    uint32_t pad2;
+    ske_fault_slot_t faults[SKE_FAULT_SLOTS];
+
     ske_event_t ev[SKE_EVENT_RING];
 } ske_ctl_t;
 
@@ -219,6 +277,9 @@ bool ske_sampling_read_seq(const void *mem, uint32_t max_size, void *msg, uint32
 /* The sequence number and time stamp of the latest message, without copying it; false when
  * none was ever written. */
 bool ske_sampling_latest(const void *mem, uint32_t max_size, uint32_t *seq, int64_t *t_ns);
+/* The latest message in place, its length (clamped to max_size) and sequence number; NULL
+ * when none was ever written. For the SKE, between windows, when no writer runs. */
+void *ske_sampling_latest_msg(void *mem, uint32_t max_size, uint32_t *len, uint32_t *seq);
 
 void ske_queue_init(void *mem, uint32_t max_size, uint32_t capacity);
 /* Number of messages between tail and head, or UINT32_MAX if the indices are inconsistent. */

@@ -114,6 +114,19 @@ bool ske_sampling_latest(const void *mem, uint32_t max_size, uint32_t *seq_out, 
     return true;
 }
 
+void *ske_sampling_latest_msg(void *mem, uint32_t max_size, uint32_t *len, uint32_t *seq)
+{
+    ske_sampling_hdr_t *h = mem;
+    uint32_t n = atomic_load_explicit(&h->seq, memory_order_acquire);
+    if (n == 0)
+        return NULL;
+    ske_slot_hdr_t *s = slot_at(mem, sizeof(*h), max_size, n & 1u);
+    uint32_t l = *(volatile uint32_t *)&s->len; /* read once: the writer may have lied */
+    *len = l < max_size ? l : max_size;
+    *seq = n;
+    return s + 1;
+}
+
 void ske_queue_init(void *mem, uint32_t max_size, uint32_t capacity)
 {
     ske_queue_hdr_t *q = mem;

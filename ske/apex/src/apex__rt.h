@@ -75,7 +75,12 @@ typedef struct {
     VALIDITY_TYPE last_validity;
     bool validity_known;
     uint32_t read_seq; /* sampling: sequence number of the last message read here, 0: none */
+    /* An injected output fault (fault.c): what WRITE_SAMPLING_MESSAGE does instead. */
+    uint8_t out_fault; /* APEX_OUT_* */
+    APEX_BYTE *fault_buf; /* corrupt: the copy it corrupts, max_size bytes */
 } apex_port_t;
+
+enum { APEX_OUT_NORMAL = 0, APEX_OUT_CORRUPT = 1, APEX_OUT_STUCK = 2 };
 
 typedef struct {
     ske_ctl_t *ctl;
@@ -99,6 +104,9 @@ typedef struct {
     apex_error_t errors[APEX_ERROR_QUEUE];
     uint32_t err_head, err_tail;
     uint32_t errors_lost;
+    /* Injected faults (fault.c): the partition time from which the hook has work to do at a
+     * service call; INT64_MAX when none. */
+    int64_t fault_due;
 } apex_rt_t;
 
 /* t + d for d ≥ 0, or false when the sum passes the end of the 64-bit clock (the standard's
@@ -118,8 +126,13 @@ extern apex_rt_t apex__rt;
 void apex__sync(void);
 /* Partition time now. */
 int64_t apex__now(void);
+/* Takes a new grant if the SKE gave one (after an overrun) and, in real time, reads the
+ * clock: the time of apex__sync without its scheduling. */
+void apex__refresh_time(void);
 /* Sends a trace event to the SKE. */
 void apex__event(uint32_t kind, int32_t a, int32_t b, const void *text, uint32_t len);
+/* Room left in the event ring for this window. */
+uint32_t apex__event_room(void);
 /* Blocks the current process (its wait fields set by the caller) until the scheduler makes
  * it ready again; returns its wait result. */
 RETURN_CODE_TYPE apex__block(apex_proc_t *p);
@@ -180,6 +193,12 @@ void apex__hm_init(void);
 void apex__hm_check_deadlines(void);
 /* Completes port waits whose condition now holds (scheduler side). */
 void apex__service_port_waiters(void);
+/* Injected faults (fault.c): arms them from the control block at attach; the hook run at a
+ * service call once rt->fault_due has come; and the write of a sampling port under an
+ * output fault (true: done, false: write normally). */
+void apex__faults_init(void);
+void apex__fault_point(void);
+bool apex__fault_write(int k, const APEX_BYTE *msg, MESSAGE_SIZE_TYPE len);
 /* Messages waiting in a queuing port, and whether any process waits on it. */
 uint32_t apex__queue_count(int k);
 int apex__queue_waiters(int k);

@@ -100,6 +100,7 @@ __attribute__((constructor(101))) static void apex_attach(void)
     setvbuf(stdout, NULL, _IOLBF, 0);
     apex__ports_attach();
     apex__hm_init();
+    apex__faults_init();
     if (apex__sandbox_install(rt->ctl) != 0)
         fatal("apex: cannot install the partition's system-call filter");
     atomic_store(&rt->ctl->ready, 1);
@@ -121,20 +122,28 @@ int64_t apex__now(void)
 
 static void release_due(void);
 
-void apex__sync(void)
+void apex__refresh_time(void)
 {
     apex_rt_t *rt = &apex__rt;
     if (atomic_load_explicit(&rt->ctl->grant_seq, memory_order_acquire) != rt->seen_grant)
         take_grant(); /* we were stopped after an overrun and continued in a new window */
-    if (rt->realtime) {
+    if (rt->realtime)
         apex__now();
-        if (rt->mode == NORMAL) {
-            /* Time moves while processes compute: releases that fell due preempt the
-             * running process at this service call. */
-            release_due();
-            apex__preempt_check();
-        }
+}
+
+void apex__sync(void)
+{
+    apex_rt_t *rt = &apex__rt;
+    apex__refresh_time();
+    if (rt->realtime && rt->mode == NORMAL) {
+        /* Time moves while processes compute: releases that fell due preempt the running
+         * process at this service call. */
+        release_due();
+        apex__preempt_check();
     }
+    /* One comparison when no fault is due: every service call passes here. */
+    if (__builtin_expect(rt->now >= rt->fault_due, 0))
+        apex__fault_point();
 }
 
 int64_t apex__next_period_start(int64_t t)
@@ -149,6 +158,14 @@ int64_t apex__next_period_start(int64_t t)
 }
 
 /* ---- events --------------------------------------------------------------------------- */
+
+uint32_t apex__event_room(void)
+{
+    ske_ctl_t *c = apex__rt.ctl;
+    uint32_t used = atomic_load_explicit(&c->ev_head, memory_order_relaxed) -
+                    atomic_load_explicit(&c->ev_tail, memory_order_acquire);
+    return used < SKE_EVENT_RING ? SKE_EVENT_RING - used : 0;
+}
 
 void apex__event(uint32_t kind, int32_t a, int32_t b, const void *text, uint32_t len)
 {

@@ -21,9 +21,22 @@ typedef struct {
     const char *lockstep_path; /* CAN bus socket whose time quanta gate the windows, or NULL */
     uint32_t node_index; /* node (redundancy channel) number given to the bus, 0 for none */
     bool quiet;
+    /* Faults to inject, each CLASS:fid=ID,at=TIME,... (faultinject/include/fi/spec.h). */
+    const char *const *faults;
+    int n_faults;
+    /* Test switches, NAME[=VALUE]: deliberate breaches of isolation, for testing oracles. */
+    const char *const *test_switches;
+    int n_test_switches;
+    bool trace_port_hashes; /* a port_hash event per source port written in a window */
 } ske_run_opts_t;
 
-/* Prepares port memory and control blocks; starts no process. err gets one line. */
+/* Checks the faults and test switches of opts against the module: SKE_OK, or SKE_E_CONFIG
+ * with one line in err. ske_create checks them too. */
+int ske_check_options(const ske_module_cfg_t *cfg, const ske_run_opts_t *opts, char *err,
+                      size_t errlen);
+
+/* Prepares port memory and control blocks; starts no process. err gets one line;
+ * SKE_E_CONFIG: a fault or test switch that cannot apply to the module. */
 int ske_create(const ske_module_cfg_t *cfg, const ske_run_opts_t *opts, ske_t **out, char *err,
                size_t errlen);
 /* Starts the partitions and runs the cyclic plan until the frame count is reached or a stop

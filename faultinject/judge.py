@@ -8,9 +8,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from faultinject import catalogue, detectors, oracles
+from faultinject import catalogue, detectors, hm_tables, oracles
 from faultinject.context import Context
-from faultinject.evidence import check
+from faultinject.evidence import Confirmation, check
 from faultinject.plan import Plan
 from faultinject.traces import RunTraces
 
@@ -61,6 +61,36 @@ def degraded_at_end(ctx: Context) -> list[str]:
     return out
 
 
+def _hm_of(ctx: Context, f, t_ns: int | None) -> dict | None:
+    """The first health-monitor decision on the fault's target after it acted, with what the
+    node's tables prescribe for it (computed from the module, faultinject.hm_tables)."""
+    if t_ns is None:
+        return None
+    nodes = ctx.node_names if f.target.node in ("*", "world", "bus") else [f.target.node]
+    for node in nodes:
+        for e in ctx.run.node_kind(node, "hm"):
+            if e["t_ns"] >= t_ns and (f.target.partition is None or
+                                      e.get("partition") == f.target.partition):
+                tables = hm_tables.read(ctx.run.module(node))
+                allowed = hm_tables.expected(tables, e.get("partition"), e.get("state"),
+                                             e.get("error"))
+                return {"node": node, "t_s": e["t_ns"] / 1e9, "partition": e.get("partition"),
+                        "error": e.get("error"), "level": e.get("level"),
+                        "action": e.get("action"),
+                        "prescribed": sorted(list(x) for x in allowed),
+                        "decisions": sum(1 for x in ctx.run.node_kind(node, "hm")
+                                         if x.get("partition") == e.get("partition"))}
+    return None
+
+
+def _expectations(fc, redundant: bool) -> dict:
+    """What the catalogue expects of a class in this system."""
+    return {"detectors": list(fc.detectors(redundant)), "latency_ms": fc.latency_ms,
+            "hm_error": fc.hm_error, "mode": fc.mode, "masked": fc.masked if redundant else None,
+            "masked_reason": fc.masked_reason if redundant else None,
+            "outcomes": list(fc.expected_outcomes(redundant))}
+
+
 def _outcome(confirmed: bool, detected: bool, degraded: bool, identical: bool,
              env_left: bool) -> str:
     if not confirmed:
@@ -74,15 +104,26 @@ def _outcome(confirmed: bool, detected: bool, degraded: bool, identical: bool,
     return "undetected_benign"
 
 
+def confirmation(ctx: Context, conf: list[Confirmation]) -> dict:
+    """Every injection confirmed by another component's record. One that was not is reported
+    as `unconfirmed` (never a pass); it is a violation unless its class may go unactivated in
+    this system (the catalogue's outcomes say `not_activated`)."""
+    missing = [(inj, c) for inj, c in zip(ctx.plan.injections, conf, strict=True)
+               if not c.confirmed]
+    text = [c.fid + (f"@{c.node}" if c.node else "") + f": {c.evidence}" for _, c in missing]
+    if not missing:
+        return {"verdict": "pass", "unconfirmed": []}
+    allowed = all("not_activated" in catalogue.get(inj.fault.cls).expected_outcomes(
+        ctx.redundant) for inj, _ in missing)
+    return {"verdict": "unconfirmed" if allowed else "fail", "unconfirmed": text}
+
+
 def judge(run_dir: Path, golden_dir: Path | None, plan: Plan, system, duration_s: float) -> dict:
     """The `faults`, `oracles` and `outcome` of a run's summary."""
     ctx = Context(run=RunTraces(run_dir), golden=RunTraces(golden_dir) if golden_dir else None,
                   plan=plan, system=system, duration_s=duration_s)
     conf = [check(ctx, inj) for inj in plan.injections]
-    verdicts = {"confirmation": {
-        "verdict": "pass" if all(c.confirmed for c in conf) else "fail",
-        "unconfirmed": [c.fid + (f"@{c.node}" if c.node else "") + f": {c.evidence}"
-                        for c in conf if not c.confirmed]}}
+    verdicts = {"confirmation": confirmation(ctx, conf)}
     verdicts.update({name: fn(ctx, conf) for name, fn in ORACLES.items()})
     degraded = degraded_at_end(ctx)
     identical = ctx.golden is not None and ctx.run.truth_bytes == ctx.golden.truth_bytes
@@ -112,6 +153,7 @@ def judge(run_dir: Path, golden_dir: Path | None, plan: Plan, system, duration_s
             "detected_by": sorted(detected), "latency_ms": None if first is None or t is None
             else round((first - t) / 1e6, 3),
             "outcome": outcome, "expected_outcomes": list(expected),
+            "hm": _hm_of(ctx, f, t), "expected": _expectations(fc, ctx.redundant),
             "known_limit": fc.known_limit["reason"] if fc.known_limit_applies(
                 ctx.redundant, f.target.node == "*") else None,
         })

@@ -93,6 +93,8 @@ class Telemetry:
             q.popleft()
 
     def position(self, t: int, lat: float, lon: float) -> None:
+        if not self.nav_flags & _POS_VALID:
+            return  # the display shows no position it does not have (held or not yet known)
         if self.ref is None or abs(lat - self.ref[0]) > 0.5 or abs(lon - self.ref[1]) > 0.5:
             self.ref = (lat, lon)  # a new local frame (also far from the old one)
             self.pos.clear()
@@ -102,8 +104,9 @@ class Telemetry:
         self._trim(self.pos, t)
 
     def data(self, t: int, alt: float, wind_from_deg: float, wind_kt: float) -> None:
-        self.alt.append((t, alt))
-        self._trim(self.alt, t)
+        if self.nav_flags & _ALT_VALID:
+            self.alt.append((t, alt))
+            self._trim(self.alt, t)
         a = wind_from_deg / DEG
         self.wind_to = (-wind_kt * math.cos(a), -wind_kt * math.sin(a))
         self.data_t = t
@@ -201,8 +204,9 @@ class PilotModel:
         self.out = (0.0, 0.0, 0.0)
         self.hdg_track.clear()
         self.last_t = None
-        self.events.append((t, {"state": "flying", "heading_deg": round(self.targets[0], 2),
-                                "altitude_ft": round(self.targets[1], 1)}))
+        self.events.append((t, {"state": "flying",
+                                "heading_deg": round(float(self.targets[0]), 2),
+                                "altitude_ft": round(float(self.targets[1]), 1)}))
 
     def _follow_script(self, t: int, station: dict) -> None:
         """A new heading or altitude in the script is the pilot's new intention."""

@@ -29,6 +29,9 @@ from .config import NS, PilotModelParams
 DEG = 180.0 / math.pi
 KT_MPS = 0.514444
 R_EARTH_M = 6_378_137.0
+# FCS_STATUS's FCS_MODE (config/can/rpas.dbc): DIRECT, and the modes that fly targets
+_DIRECT = 1
+_TARGET_MODES = (2, 3, 4)  # AUTOPILOT, MISSION, CONTINGENCY
 _POS_VALID = 0x1 | 0x8  # FCS_NAV_FLAGS: GPS or dead reckoning: the position is current
 _ALT_VALID = 0x1 | 0x4  # GPS or air data: the altitude is current
 
@@ -127,6 +130,7 @@ class PilotModel:
         self.flying = False
         self.direct_since: int | None = None  # when the downlink first showed DIRECT
         self.targets: tuple[float, float] | None = None  # heading, altitude held
+        self._script_targets: tuple[float, float] | None = None  # the script's, last seen
         self.last_auto_targets: tuple[float, float] | None = None  # the FCS's, not in DIRECT
         self.hdg_track: deque = deque()  # (t_ns, unwrapped heading estimate)
         self.roll_trim = self.pitch_trim = 0.0
@@ -167,8 +171,8 @@ class PilotModel:
         """(pitch, roll, power) the pilot puts on the stick at t (power: added to the station's
         throttle), or None: the script's stick."""
         tm = self.shown(t) if link_up else None
-        direct = tm is not None and tm.mode == 1  # FCS_MODE DIRECT
-        if tm is not None and not direct and tm.mode in (2, 3, 4):
+        direct = tm is not None and tm.mode == _DIRECT
+        if tm is not None and tm.mode in _TARGET_MODES:
             self.last_auto_targets = (tm.tgt_hdg, tm.tgt_alt)
         if not (self.enabled and direct and not scripted):
             self.direct_since = None

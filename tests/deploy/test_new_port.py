@@ -19,8 +19,8 @@ from ima.launch import options as launch_options
 from ima.launch import run as launch_run
 
 ROOT = Path(__file__).resolve().parents[2]
-SOURCES = ("CMakeLists.txt", "bench", "config", "health_monitor", "nodes", "partitions", "python",
-           "ske", "tests")
+SOURCES = ("CMakeLists.txt", "bench", "config", "faultinject", "health_monitor", "nodes",
+           "partitions", "python", "ske", "tests")
 
 MODEL_EDIT = {
     # io's ports: a new source port

@@ -25,6 +25,7 @@ void fcs_init(fcs_t *fcs, const fcs_params_t *prm)
     fcs->req_mode = RPAS_MODE_INIT;
     fcs->thr = fcs->prm.thr_ff;
     fcs->tgt.ias = 100.0;
+    fcs->sensors_ok_since_ns = -1;
 }
 
 static double age_s(int64_t now_ns, int64_t t_ns)
@@ -80,7 +81,28 @@ static fcs_targets_t capture_state(const fcs_t *f, const rpas_nav_msg_t *nav)
     return sane_targets(f, RPAS_LAT_HDG, RPAS_VERT_ALT, nav->hdg_deg, nav->alt_ft, ias, 0.0);
 }
 
-/* Picks the mode, the fallback and the targets: the mode table of README.md. */
+/* Attitude (AHRS) or air data unusable: the autopilot loops cannot be trusted. A source that
+ * has never been seen counts as lost only sensor_wait_s after the start (the first samples
+ * need a frame or two); leaving SENSOR_LOST needs both good for sensor_reengage_s, so that a
+ * sensor that comes and goes does not toggle the mode at its own rate. */
+static bool sensors_degraded(fcs_t *f, const rpas_nav_msg_t *nav, int64_t now_ns)
+{
+    const fcs_params_t *p = &f->prm;
+    bool att = nav->flags & RPAS_NAV_AHRS, air = nav->flags & RPAS_NAV_AIR;
+    f->att_seen |= att;
+    f->air_seen |= air;
+    bool started = age_s(now_ns, f->t0_ns) >= p->sensor_wait_s;
+    if (!(att && air))
+        f->sensors_ok_since_ns = -1;
+    else if (f->sensors_ok_since_ns < 0)
+        f->sensors_ok_since_ns = now_ns;
+    if ((!att && (f->att_seen || started)) || (!air && (f->air_seen || started)))
+        return true;
+    return f->fallback == RPAS_FB_SENSOR_LOST && (f->sensors_ok_since_ns < 0 ||
+                                                  age_s(now_ns, f->sensors_ok_since_ns) < p->sensor_reengage_s);
+}
+
+/* Picks the mode, the fallback and the targets: the mode table of docs/degraded-modes.md. */
 static void select_mode(fcs_t *f, const fcs_inputs_t *in, const rpas_nav_msg_t *nav, int64_t now_ns,
                         bool *direct_ok)
 {
@@ -144,6 +166,21 @@ static void select_mode(fcs_t *f, const fcs_inputs_t *in, const rpas_nav_msg_t *
         break;
     }
 
+    /* Degraded sensors: the remote pilot flies (DIRECT) while he can; without him, the state
+     * is held as when the link is lost in DIRECT (below: or the attitude-free commands). */
+    bool degraded = sensors_degraded(f, nav, now_ns); /* every step: it keeps its own state */
+    if (degraded && req != RPAS_MODE_DIRECT) {
+        if (stick_fresh(f, in, pilot_now, now_ns)) {
+            mode = RPAS_MODE_DIRECT;
+            fb = RPAS_FB_SENSOR_LOST;
+            *direct_ok = true;
+        } else {
+            mode = RPAS_MODE_AUTOPILOT;
+            fb = RPAS_FB_C2_LOST;
+            hold = true;
+        }
+    }
+
     bool attitude = nav->flags & RPAS_NAV_AHRS;
     if (!attitude && mode != RPAS_MODE_DIRECT) {
         /* No loop can run without attitude: INIT until there has been one, else AUTOPILOT with
@@ -151,6 +188,8 @@ static void select_mode(fcs_t *f, const fcs_inputs_t *in, const rpas_nav_msg_t *
         mode = f->mode == RPAS_MODE_INIT ? RPAS_MODE_INIT : RPAS_MODE_AUTOPILOT;
         fb = RPAS_FB_NAV_INVALID;
         f->holding = false;
+    } else if (mode == RPAS_MODE_DIRECT) {
+        f->holding = false; /* targets stay as they were; a hold after DIRECT captures anew */
     } else if (hold) {
         if (!f->holding)
             f->tgt = capture_state(f, nav);
@@ -371,6 +410,8 @@ void fcs_step(fcs_t *f, const fcs_inputs_t *in, const rpas_nav_msg_t *nav, int64
 {
     const fcs_params_t *p = &f->prm;
     double dt = f->started ? nf_clamp(age_s(now_ns, f->last_ns), 0.0, 0.2) : 0.05;
+    if (!f->started)
+        f->t0_ns = now_ns;
     f->started = true;
     f->last_ns = now_ns;
     f->env_flags = 0;

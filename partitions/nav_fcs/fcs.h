@@ -71,7 +71,9 @@
     X(stick_max_age_s, 1.0, "stick data older than this: DIRECT is not available")            \
     X(mission_max_age_s, 1.0, "mission targets older than this are stale")                    \
     X(mission_reengage_s, 1.0, "mission targets must be good this long to leave a fallback")  \
-    X(direct_blend_s, 1.0, "fade from the last autopilot command to the stick on DIRECT")
+    X(direct_blend_s, 1.0, "fade from the last autopilot command to the stick on DIRECT")     \
+    X(sensor_wait_s, 1.0, "after the start, attitude or air data never seen counts as lost")   \
+    X(sensor_reengage_s, 2.0, "attitude and air data good this long to leave SENSOR_LOST")
 
 typedef struct {
 #define FCS_PARAM_FIELD(name, def, doc) double name;
@@ -112,6 +114,9 @@ typedef struct {
     fcs_targets_t tgt;       /* the targets being flown */
     bool mission_good;       /* mission targets accepted (after mission_reengage_s) */
     int64_t mission_ok_since_ns;
+    int64_t t0_ns;           /* the first step */
+    bool att_seen, air_seen; /* the navigation has had attitude / air data once */
+    int64_t sensors_ok_since_ns; /* attitude and air data both good since (-1: not now) */
     /* control state */
     bool loops_active;       /* autopilot loops running (else re-initialised on entry) */
     double bank_cmd, vs_cmd, ias_cmd;

@@ -66,7 +66,8 @@ static const char *mode_name(uint32_t m)
 
 static const char *fallback_name(uint32_t f)
 {
-    static const char *const names[] = {"NONE", "C2_LOST", "MISSION_STALE", "NAV_INVALID", "NO_TARGETS"};
+    static const char *const names[] = {"NONE",        "C2_LOST",    "MISSION_STALE",
+                                        "NAV_INVALID", "NO_TARGETS", "SENSOR_LOST"};
     return f < sizeof names / sizeof names[0] ? names[f] : "?";
 }
 

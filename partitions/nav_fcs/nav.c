@@ -13,6 +13,7 @@ void nav_default_params(nav_params_t *prm)
     prm->gps_frozen_s = 0.7; /* 5 Hz receiver: three missed fixes */
     prm->ahrs_max_age_s = 0.2;
     prm->ahrs_frozen_s = 0.2;
+    prm->ahrs_stuck_s = 0.5; /* 25 samples at 50 Hz: noise alone never repeats them all */
     prm->air_max_age_s = 0.4;
     prm->air_frozen_s = 0.4;
     prm->wind_tau_s = 20.0;
@@ -66,6 +67,23 @@ static bool gps_usable(nav_t *nav, const nav_inputs_t *in, int64_t now_ns)
            g->gs_kt >= 0.0 && g->gs_kt < 1000.0;
 }
 
+/* True while the values keep changing. A real AHRS's outputs carry noise: attitude, rates and
+ * accelerations all repeating bit for bit, sample after sample, is a sensor stuck behind a
+ * live counter and a valid status, which the counter check cannot see. */
+static bool values_alive(nav_t *nav, const double v[9], int64_t now_ns)
+{
+    bool same = nav->ahrs_vals_seen;
+    for (int i = 0; i < 9 && same; i++)
+        same = v[i] == nav->ahrs_vals[i];
+    if (!same) {
+        memcpy(nav->ahrs_vals, v, sizeof nav->ahrs_vals);
+        nav->ahrs_vals_seen = true;
+        nav->ahrs_vals_change_ns = now_ns;
+        return true;
+    }
+    return (double)(now_ns - nav->ahrs_vals_change_ns) * 1e-9 < nav->prm.ahrs_stuck_s;
+}
+
 static bool ahrs_usable(nav_t *nav, const nav_inputs_t *in, int64_t now_ns)
 {
     const rpas_ahrs_msg_t *a = &in->ahrs;
@@ -74,8 +92,10 @@ static bool ahrs_usable(nav_t *nav, const nav_inputs_t *in, int64_t now_ns)
     bool alive = seq_alive(&nav->ahrs_seq, a->seq, now_ns, nav->prm.ahrs_frozen_s);
     double v[] = {a->roll_deg, a->pitch_deg, a->hdg_deg, a->p_dps, a->q_dps, a->r_dps,
                   a->ax_g, a->ay_g, a->az_g};
-    return alive && fresh(now_ns, a->t_ns, nav->prm.ahrs_max_age_s) && (a->status & 0x3) == 0x3 &&
-           all_finite(v, 9) && fabs(a->roll_deg) <= 180.0 && fabs(a->pitch_deg) <= 90.0;
+    bool moving = values_alive(nav, v, now_ns);
+    return alive && moving && fresh(now_ns, a->t_ns, nav->prm.ahrs_max_age_s) &&
+           (a->status & 0x3) == 0x3 && all_finite(v, 9) && fabs(a->roll_deg) <= 180.0 &&
+           fabs(a->pitch_deg) <= 90.0;
 }
 
 static bool air_usable(nav_t *nav, const nav_inputs_t *in, int64_t now_ns)

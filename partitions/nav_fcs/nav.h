@@ -23,6 +23,7 @@ typedef struct {
     double gps_frozen_s;   /* GPS_CNT unchanged this long: receiver frozen */
     double ahrs_max_age_s;
     double ahrs_frozen_s;
+    double ahrs_stuck_s;   /* every AHRS value unchanged this long, counter running: stuck */
     double air_max_age_s;
     double air_frozen_s;
     double wind_tau_s;     /* time constant of the wind estimate's low-pass filter */
@@ -41,6 +42,9 @@ typedef struct {
     bool started;
     int64_t last_ns;
     nav_seq_t gps_seq, ahrs_seq, air_seq;
+    double ahrs_vals[9];     /* the AHRS values of the last sample that changed one of them */
+    bool ahrs_vals_seen;
+    int64_t ahrs_vals_change_ns;
     bool have_pos;       /* lat/lon known (from a GPS fix, then dead reckoning) */
     double lat_deg, lon_deg;
     double vn_kt, ve_kt; /* ground velocity used to propagate the position */

@@ -11,6 +11,14 @@ from ima.errors import ImaError
 
 from .config import VotingParams
 
+TEST_SWITCHES = ("no-vote-out",)
+
+
+def _fault_classes() -> str:
+    from .faults import describe
+
+    return describe()
+
 
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(
@@ -45,6 +53,14 @@ def build_parser() -> argparse.ArgumentParser:
                     "(voting.offset_s)")
     ap.add_argument("--vote-period", type=float, default=None, metavar="S",
                     help="the voting frame: the system's major frame (schedule.major_frame_s)")
+    ap.add_argument("--fault", action="append", default=[], metavar="SPEC",
+                    help="inject a fault (repeatable): CLASS:fid=ID,at=TIME[,until=TIME]"
+                    "[,period=TIME,on=TIME][,KEY=VALUE...] (faultinject/include/fi/spec.h); "
+                    "classes: " + _fault_classes())
+    ap.add_argument("--test-switch", action="append", default=[], choices=TEST_SWITCHES,
+                    metavar="NAME",
+                    help="TEST ONLY: no-vote-out makes the actuators' voter never vote a "
+                    "channel out (to show that a campaign oracle can fail)")
     ap.add_argument("--status", action="store_true",
                     help="print one JSON progress line per emulated second on stdout")
     ap.add_argument("--name", default="world", help="client name on the bus")
@@ -102,6 +118,18 @@ def vote_options(args) -> dict:
             "voting": VotingParams(thr, args.vote_persist, args.vote_offset, period)}
 
 
+def fault_options(args) -> list:
+    """The --fault specs, parsed and checked against the world's classes (ImaError, exit 2,
+    one line, when one is bad)."""
+    from .config import DEFAULT
+    from .faults import check_all
+    from .faultspec import parse
+
+    specs = [parse(text) for text in args.fault]
+    check_all(specs, DEFAULT.faults)
+    return specs
+
+
 def run(args) -> int:
     from ima.canbus import proto
     from ima.canbus.client import BusClient
@@ -114,10 +142,12 @@ def run(args) -> int:
     if args.wind is not None and args.wind < 0:
         raise ImaError("--wind must not be negative", exit_code=2)
     voting = vote_options(args)
+    faults = fault_options(args)
     status_out = quiet_stdout()  # JSBSim prints to stdout; only --status lines may go there
     opts = Options(seed=args.seed, turbulence=args.turbulence or script.turbulence or "none",
                    wind_kt=args.wind, wind_from_deg=args.wind_from,
-                   terrain_ft=args.terrain_ft, status=args.status, **voting)
+                   terrain_ft=args.terrain_ft, status=args.status, faults=faults,
+                   test_switches=tuple(dict.fromkeys(args.test_switch)), **voting)
     if script.start["altitude_ft"] - opts.terrain_ft < 200:
         raise ImaError(f"{args.pilot}: start.altitude_ft {script.start['altitude_ft']} is less "
                        f"than 200 ft above the terrain ({opts.terrain_ft} ft)", exit_code=2)

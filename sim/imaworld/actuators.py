@@ -78,11 +78,14 @@ class VotingSelector(CommandSelector):
     latches_safe = True
 
     def __init__(self, n_channels: int, thresholds: tuple, persist: int, offset_ns: int,
-                 period_ns: int, safe=(0.0, 0.0, 0.0, 0.0)) -> None:
+                 period_ns: int, safe=(0.0, 0.0, 0.0, 0.0), never_vote_out: bool = False) -> None:
         if not 0 <= offset_ns < period_ns:
             raise ValueError(f"vote offset {offset_ns} ns is not within the {period_ns} ns frame")
         super().__init__(n_channels)
         self.n = n_channels
+        # test switch no-vote-out: a channel the voter declares failed is taken back at once
+        # and no voted_out is recorded (only to show that an oracle can fail)
+        self.never_vote_out = never_vote_out
         self.voter = Voter(n_channels, 4, thresholds, persist, safe)
         self.period_ns = period_ns
         self.next_vote_t = offset_ns
@@ -131,6 +134,9 @@ class VotingSelector(CommandSelector):
         if r.status != self.status or used != self.used:
             self.status, self.used = r.status, used
             self.events.append((tv, "vote", {"status": r.status, "used": list(used)}))
+        if r.newly_failed and self.never_vote_out:
+            self.voter.forgive(r.newly_failed)
+            return
         for c in range(self.n):
             if r.newly_failed >> c & 1:
                 rec = {"node": f"node{c + 1}", "channel": CHANNELS[c],
@@ -171,6 +177,21 @@ class Actuators:
         self.hi = (lim, lim, lim, p.throttle_max)
         self.safe = safe_position(p)
         self.transitions: list[tuple[int, str, str | None]] = []  # (t_ns, state, channel)
+        # Set by the fault injectors (faults.py): per actuator None, ("jam", position, 0) or
+        # ("drive", position, rate): the actuator goes there at that rate, whatever the command.
+        self.override: list | None = None
+
+    def rate(self, i: int) -> float:
+        """Actuator i's rate limit (normalised units per second)."""
+        return self.p.throttle_rate if i == 3 else self.p.surface_rate
+
+    def limit(self, i: int, side: int) -> float:
+        """Actuator i's end stop on the side of `side`'s sign."""
+        return self.hi[i] if side > 0 else self.lo[i]
+
+    def neutral(self, i: int) -> float:
+        """Where actuator i goes undriven: 0 (surfaces trail with the flow; throttle at idle)."""
+        return min(max(0.0, self.lo[i]), self.hi[i])
 
     def command(self, channel: int, t_ns: int, cmd: tuple) -> None:
         """An ACT_CMD frame of redundancy channel `channel` (0 = A) that ended at t_ns."""
@@ -211,14 +232,19 @@ class Actuators:
         target = self._target(now_ns)
         p = self.p
         pos, lo, hi = self.pos, self.lo, self.hi
+        ov = self.override
         for i in range(4):
             tgt = target[i]
             if tgt < lo[i]:
                 tgt = lo[i]
             elif tgt > hi[i]:
                 tgt = hi[i]
+            if ov is not None and ov[i] is not None:
+                tgt, rate = ov[i][1], ov[i][2]  # a faulty actuator: the command does not count
+                m = rate * dt_s
+            else:
+                m = (p.throttle_rate if i == 3 else p.surface_rate) * dt_s
             d = tgt - pos[i]
-            m = (p.throttle_rate if i == 3 else p.surface_rate) * dt_s
             if d > m:
                 d = m
             elif d < -m:

@@ -84,6 +84,42 @@ class StationParams:
 
 
 @dataclass(frozen=True)
+class PilotModelParams:
+    """The remote pilot model (pilot_model.py): how a remote pilot flies DIRECT from the
+    downlinked telemetry alone (no attitude is downlinked: bank is read off the turn rate,
+    heading off the ground track and the wind estimate). Gains are those of a calm, unhurried
+    pilot: corrections of a few degrees and a few hundred ft/min."""
+    takeover_s: float = 1.0  # from the downlink first showing DIRECT to the pilot's first input
+    reaction_s: float = 0.3  # every input acts on what the telemetry showed this long before
+    window_s: float = 1.0  # the pilot's eye: the track's trend over this much telemetry
+    vs_window_s: float = 2.0  # ... and the altitude's
+    fresh_s: float = 1.0  # telemetry older than this is not flown on
+    # lateral: heading error -> desired turn rate -> roll stick on the turn-rate error
+    hdg_gain: float = 0.1  # deg/s of turn rate per degree of heading error
+    turn_rate_max: float = 1.5  # deg/s (half a standard-rate turn)
+    roll_gain: float = 0.04  # roll stick per deg/s of turn-rate error
+    roll_trim_gain: float = 0.004  # roll stick per deg/s-second (the pilot trims out a drift)
+    roll_trim_max: float = 0.1
+    roll_max: float = 0.2  # the largest roll input the pilot makes
+    # vertical: altitude error -> desired vertical speed -> pitch stick
+    alt_gain: float = 5.0  # ft/min per ft of altitude error
+    vs_max: float = 500.0  # ft/min
+    pitch_gain: float = 0.00005  # pitch stick per ft/min of vertical-speed error
+    pitch_trim_gain: float = 0.000005  # pitch stick per ft/min-second
+    pitch_trim_max: float = 0.15
+    pitch_max: float = 0.2
+    climb_power: float = 0.0002  # throttle added per ft/min of vertical speed wanted
+
+
+@dataclass(frozen=True)
+class FaultParams:
+    # actuator_float without rate=: a surface no longer driven is brought back to its
+    # aerodynamic neutral by its hinge moment, slowed by the actuator's own damping (a
+    # backdriven jack); full travel to neutral in 10 s.
+    float_rate_per_s: float = 0.1
+
+
+@dataclass(frozen=True)
 class AtmosphereParams:
     # MIL-F-8785C turbulence via JSBSim's Milspec model: (severity, wind at 20 ft AGL in kt).
     turbulence: dict = field(default_factory=lambda: {
@@ -110,6 +146,8 @@ class WorldParams:
     station: StationParams = field(default_factory=StationParams)
     atmosphere: AtmosphereParams = field(default_factory=AtmosphereParams)
     limits: LimitParams = field(default_factory=LimitParams)
+    faults: FaultParams = field(default_factory=FaultParams)
+    pilot_model: PilotModelParams = field(default_factory=PilotModelParams)
 
 
 DEFAULT = WorldParams()

@@ -48,6 +48,8 @@ SCHEMA = {
             },
         },
         "turbulence": {"enum": ["none", "light", "moderate"]},
+        # the remote pilot model flies DIRECT when the script does not (pilot_model.py)
+        "pilot_model": {"type": "boolean"},
         "events": {
             "type": "array",
             "items": {
@@ -114,6 +116,7 @@ class PilotScript:
     turbulence: str | None = None
     duration_s: float | None = None
     description: str = ""
+    pilot_model: bool = True
     initial: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -208,7 +211,8 @@ def parse(doc, path: str = "<script>") -> PilotScript:
         path=path, start=start, events=events,
         settle_s=(doc.get("evaluate") or {}).get("settle_s"),
         wind=doc.get("wind"), turbulence=doc.get("turbulence"),
-        duration_s=doc.get("duration_s"), description=doc.get("description", ""))
+        duration_s=doc.get("duration_s"), description=doc.get("description", ""),
+        pilot_model=doc.get("pilot_model", True))
 
 
 def load(path: str | Path) -> PilotScript:

@@ -66,18 +66,25 @@ class Gps:
         self.bn = GaussMarkov(rng, p.bias_sigma_h_m, p.bias_tau_s, dt)
         self.be = GaussMarkov(rng, p.bias_sigma_h_m, p.bias_tau_s, dt)
         self.bd = GaussMarkov(rng, p.bias_sigma_v_m, p.bias_tau_s, dt)
-        self.state = "ok"
+        self.state = "ok"  # the pilot script's
+        self.fault_state: str | None = None  # a fault's "lost" / "frozen": wins over the script
+        self.offset: tuple[float, float] | None = None  # a fault's jump: north, east metres
         self.cnt = 0
         self.last: list[tuple[int, bytes]] = []
+
+    @property
+    def effective_state(self) -> str:
+        return self.fault_state or self.state
 
     def sample(self, lat: float, lon: float, alt_ft: float, vn_fps: float,
                ve_fps: float) -> list[tuple[int, bytes]]:
         p, n = self.p, self.n
         bn, be, bd = self.bn.step(), self.be.step(), self.bd.step()  # biases run in every state
-        if self.state == "frozen":
+        state = self.fault_state or self.state
+        if state == "frozen":
             return self.last  # same data, same counter
         self.cnt = (self.cnt + 1) & 0xFF
-        if self.state == "lost":
+        if state == "lost":
             if p.lost_mode == "silent":
                 return []
             out = [(_GPS_POS.frame_id, _GPS_POS.encode(0.0, 0.0)),
@@ -87,6 +94,9 @@ class Gps:
         dn = bn + p.noise_h_m * n()
         de = be + p.noise_h_m * n()
         du = bd + p.noise_v_m * n()
+        if self.offset is not None:
+            dn += self.offset[0]
+            de += self.offset[1]
         mlat = lat + dn / R_EARTH_M * DEG
         mlon = lon + de / (R_EARTH_M * math.cos(lat / DEG)) * DEG
         if mlon >= 180.0:
@@ -119,13 +129,15 @@ class Ahrs:
         self.b_rate = [gm(rng, p.bias_sigma_rate_dps, p.bias_tau_s, dt) for _ in range(3)]
         self.b_acc = [gm(rng, p.bias_sigma_accel_g, p.bias_tau_s, dt) for _ in range(3)]
         self.cnt = 0
+        self.fault_ops: list | None = None  # set by the fault injectors (faults.py)
+        self.last_vals: tuple | None = None  # the values of the last frames sent
+        self.last_frames: list[tuple[int, bytes]] = []
 
     def sample(self, phi: float, theta: float, psi: float, p_: float, q: float, r: float,
                ax: float, ay: float, az: float) -> list[tuple[int, bytes]]:
         """Angles in degrees, rates in rad/s, specific force in g (body axes, z down)."""
         P, n = self.p, self.n
         ba, br, bc = self.b_att, self.b_rate, self.b_acc
-        self.cnt = c = (self.cnt + 1) & 0xFF
         roll = phi + ba[0].step() + P.noise_att_deg * n()
         if roll > 180.0:
             roll -= 360.0
@@ -136,15 +148,81 @@ class Ahrs:
         if hdg >= 359.995:
             hdg = 0.0
         nr, na = P.noise_rate_dps, P.noise_accel_g
-        return [
-            (_AHRS_ATT.frame_id, _AHRS_ATT.encode(roll, pitch, hdg, 3, c)),
-            (_AHRS_RATE.frame_id, _AHRS_RATE.encode(
+        # the errors are drawn in every state: a fault leaves the streams as they were
+        vals = (roll, pitch, hdg,
                 p_ * DEG + br[0].step() + nr * n(), q * DEG + br[1].step() + nr * n(),
-                r * DEG + br[2].step() + nr * n(), 3, c)),
-            (_AHRS_ACCEL.frame_id, _AHRS_ACCEL.encode(
+                r * DEG + br[2].step() + nr * n(),
                 ax + bc[0].step() + na * n(), ay + bc[1].step() + na * n(),
-                az + bc[2].step() + na * n(), 3, c)),
+                az + bc[2].step() + na * n())
+        fill = None
+        if self.fault_ops is not None:
+            vals, frames, fill = self._faulty(vals)
+            if frames:
+                return frames  # frozen: the last frames again, counters included
+        self.cnt = c = (self.cnt + 1) & 0xFF
+        out = [
+            (_AHRS_ATT.frame_id, _AHRS_ATT.encode(vals[0], vals[1], vals[2], 3, c)),
+            (_AHRS_RATE.frame_id, _AHRS_RATE.encode(vals[3], vals[4], vals[5], 3, c)),
+            (_AHRS_ACCEL.frame_id, _AHRS_ACCEL.encode(vals[6], vals[7], vals[8], 3, c)),
         ]
+        if fill is not None:
+            fill[1] = out
+        self.last_vals = vals
+        self.last_frames = out
+        return out
+
+    def _faulty(self, vals: tuple) -> tuple[tuple, list | None, list | None]:
+        """The values the active faults make of a sample, in the order they were applied:
+        ("stuck", [values, frames], counter frozen) replaces every value (or sends the frames
+        again); ("bias", index, value) adds to one. A stuck AHRS with nothing sent before its
+        spell repeats the spell's first sample: that one fills the holder (returned)."""
+        v = list(vals)
+        frames = fill = None
+        for op in self.fault_ops:
+            if op[0] == "stuck":
+                held = op[1]
+                if held[0] is None:
+                    held[0] = tuple(v)
+                    fill = held if op[2] else None
+                    frames = None
+                else:
+                    v = list(held[0])
+                    frames = held[1] if op[2] else None
+            else:
+                i, b = op[1], op[2]
+                v[i] += b
+                frames = None
+        if v[0] > 180.0:
+            v[0] -= 360.0
+        elif v[0] < -180.0:
+            v[0] += 360.0
+        v[1] = max(-90.0, min(90.0, v[1]))
+        v[2] %= 360.0
+        if v[2] >= 359.995:
+            v[2] = 0.0
+        return tuple(v), frames, fill
+
+
+# ISA sea-level pressure and speed of sound, for the pitot-static relations below.
+P0_PA = 101325.0
+A0_KT = 661.4786
+
+
+def impact_pressure(cas_kt: float) -> float:
+    """Pitot minus static pressure (Pa) at a calibrated airspeed (subsonic, compressible)."""
+    return P0_PA * ((1.0 + 0.2 * (cas_kt / A0_KT) ** 2) ** 3.5 - 1.0)
+
+
+def cas_from_impact(qc_pa: float) -> float:
+    """The calibrated airspeed an air-data computer reads from an impact pressure (>= 0)."""
+    if qc_pa <= 0.0:
+        return 0.0
+    return A0_KT * math.sqrt(5.0 * ((qc_pa / P0_PA + 1.0) ** (2.0 / 7.0) - 1.0))
+
+
+def static_pressure(palt_ft: float) -> float:
+    """ISA static pressure (Pa) at a pressure altitude (troposphere)."""
+    return P0_PA * (1.0 - 6.8755856e-6 * palt_ft) ** 5.2558797
 
 
 class AirData:

@@ -169,6 +169,16 @@ class Voter:
     def reset(self) -> None:
         self._lib.voter_reset(ctypes.byref(self._v))
 
+    def forgive(self, mask: int) -> None:
+        """Test switch only (imaworld --test-switch no-vote-out): the channels of `mask` are
+        no longer failed, their bad-frame counts start again from 0."""
+        v = self._v
+        v.failed &= ~mask & 0xFF
+        for c in range(self.n):
+            if mask >> c & 1:
+                v.count[c] = 0
+                v.reason[c] = 0
+
     @property
     def failed(self) -> int:
         """Bit c: channel c failed (latched)."""

@@ -7,7 +7,7 @@ import json
 import math
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ima.canbus import proto
@@ -15,9 +15,12 @@ from ima.canbus.codec import BY_ID, MESSAGES, choices
 
 from .actuators import CHANNELS, Actuators, LowestLiveChannel, VotingSelector, safe_position
 from .config import DEFAULT, NS, VotingParams, WorldParams
+from .faults import WorldFaults
+from .faultspec import FaultSpec
 from .fdm import Aircraft
 from .pilot import LAT_MODE_CODES, MODE_CODES, VERT_MODE_CODES, PilotScript
-from .sensors import Ahrs, AirData, Gps
+from .pilot_model import PilotModel
+from .sensors import Ahrs, AirData, Gps, cas_from_impact, static_pressure
 
 INF = 1 << 62
 
@@ -29,6 +32,10 @@ _ACT_CMD = {MESSAGES[f"ACT_CMD_{c}"].frame_id: (i, MESSAGES[f"ACT_CMD_{c}"].deco
             for i, c in enumerate(CHANNELS)}
 _FCS_STATUS = {MESSAGES[f"FCS_STATUS_{c}"].frame_id: (i, MESSAGES[f"FCS_STATUS_{c}"].decode)
                for i, c in enumerate(CHANNELS)}
+_NAV_POS = {MESSAGES[f"NAV_POS_{c}"].frame_id: (i, MESSAGES[f"NAV_POS_{c}"].decode)
+            for i, c in enumerate(CHANNELS)}
+_NAV_DATA = {MESSAGES[f"NAV_DATA_{c}"].frame_id: (i, MESSAGES[f"NAV_DATA_{c}"].decode)
+             for i, c in enumerate(CHANNELS)}
 FCS_MODES = choices("FCS_STATUS_A", "FCS_MODE_A")
 FCS_FALLBACKS = choices("FCS_STATUS_A", "FCS_FALLBACK_A")
 
@@ -50,6 +57,10 @@ class Options:
     # replica, simplex: the lowest live channel is used, nothing is voted.
     channels: int | None = None
     voting: VotingParams | None = None
+    faults: list[FaultSpec] = field(default_factory=list)  # --fault, in command-line order
+    # Test-only switches (--test-switch): "no-vote-out" makes the voter never vote a
+    # channel out, to show that a campaign oracle can fail.
+    test_switches: tuple[str, ...] = ()
 
 
 def _r(x: float, n: int) -> float | None:
@@ -90,7 +101,8 @@ class World:
         tr = self.trim
         self.voting = opts.voting
         self.act = Actuators(params.actuators, (tr["elev"], tr["ail"], tr["rud"], tr["thr"]),
-                             self._selector(opts.channels, opts.voting, params))
+                             self._selector(opts.channels, opts.voting, params,
+                                            "no-vote-out" in opts.test_switches))
         self.ac.set_controls(*self.act.pos)
         self.gps = Gps(params.gps, seed)
         self.ahrs = Ahrs(params.ahrs, seed)
@@ -101,6 +113,9 @@ class World:
         self.stk_cnt = 0
         self.fcs_status: list[tuple[int, int, int] | None] = [None, None, None]  # (t, mode, fb)
         self.fcs_last: tuple[int, int] | None = None
+        self.pilot_model = PilotModel(params.pilot_model, script.pilot_model)
+        self._pm_done = 0
+        self._stick_scripted = False  # the script flies the stick itself (see _scripted)
         # bookkeeping
         self.hz = params.physics_hz
         self.dt = 1.0 / self.hz
@@ -124,10 +139,12 @@ class World:
                    terrain_ft=_r(opts.terrain_ft, 3),
                    trim={k: _r(v, 6) for k, v in self.trim.items()},
                    start=script.start)
+        self.faults = WorldFaults(opts.faults, self, params.faults) if opts.faults else None
         self._tasks = self._make_tasks()
 
     @staticmethod
-    def _selector(channels: int | None, vp: VotingParams | None, params: WorldParams):
+    def _selector(channels: int | None, vp: VotingParams | None, params: WorldParams,
+                  never_vote_out: bool = False):
         if channels is None:
             return LowestLiveChannel()
         if channels not in (1, 2, 3):
@@ -136,7 +153,7 @@ class World:
             raise ValueError("voted channels need the voting parameters (Options.voting)")
         return VotingSelector(channels, tuple(vp.thresholds), vp.persist,
                               round(vp.offset_s * NS), round(vp.period_s * NS),
-                              safe_position(params.actuators))
+                              safe_position(params.actuators), never_vote_out)
 
     # -- output --------------------------------------------------------------------------
     def event(self, src: str, kind: str, t_ns: int | None = None, **fields) -> None:
@@ -162,6 +179,10 @@ class World:
         m, fb = self.fcs_last
         return FCS_MODES.get(m, str(m)), FCS_FALLBACKS.get(fb, str(fb))
 
+    def link_up(self) -> bool:
+        """The C2 link as it is: the script's state, unless a c2_loss fault has it down."""
+        return self.station["c2_link"] == "up" and not (self.faults and self.faults.c2_down)
+
     def truth(self) -> dict:
         g = self.ac.get
         pos = self.act.pos
@@ -180,7 +201,7 @@ class World:
             "elev": _r(pos[0], 4), "ail": _r(pos[1], 4), "rud": _r(pos[2], 4),
             "thr": _r(pos[3], 4),
             "fcs_mode": mode, "fcs_fallback": fb,
-            "c2_link": self.station["c2_link"], "gps": self.gps.state,
+            "c2_link": "up" if self.link_up() else "down", "gps": self.gps.effective_state,
             "wind_n_kt": _r(g["wind_n"]() / 1.6878098571011957, 3),
             "wind_e_kt": _r(g["wind_e"]() / 1.6878098571011957, 3),
         }
@@ -190,7 +211,7 @@ class World:
         p = self.p
         ms = 1_000_000
         tasks = [
-            [self._next_event_t(), 0, self._pilot_events],
+            [self._next_event_t(), 0, self._pilot_events, self._next_event_t],
             [0, p.gps.period_ms * ms, self._gps],
             [0, p.ahrs.period_ms * ms, self._ahrs],
             [0, p.adc.period_ms * ms, self._adc],
@@ -201,6 +222,9 @@ class World:
         ]
         if self.status_out is not None:
             tasks.append([0, NS, self._status])
+        if self.faults is not None:
+            # first at an instant: a spell that starts then acts on that instant's samples
+            tasks.insert(0, [self.faults.next_t(), 0, self.faults.due, self.faults.next_t])
         return tasks
 
     def _next_event_t(self) -> int:
@@ -214,6 +238,10 @@ class World:
             self._evt_idx += 1
             old = self.station
             self.station = PilotScript.apply(old, e)
+            if "mode" in e:
+                self._stick_scripted = False
+            if "stick" in e:
+                self._stick_scripted = True
             fields = {k: v for k, v in e.items() if k != "t"}
             self.event("pilot", "pilot_event", **fields)
             if self.station["c2_link"] != old["c2_link"]:
@@ -238,7 +266,11 @@ class World:
 
     def _adc(self, t: int) -> None:
         g = self.ac.get
-        self._send(t, self.adc.sample(g["cas"](), g["palt"](), g["hdot"]()))
+        cas = g["cas"]()
+        pt = self.faults.pitot_pt if self.faults else None
+        if pt is not None:  # blocked pitot: the trapped total pressure against the static
+            cas = cas_from_impact(pt - static_pressure(g["palt"]()))
+        self._send(t, self.adc.sample(cas, g["palt"](), g["hdot"]()))
 
     def _act_status(self, t: int) -> None:
         pos = self.act.pos
@@ -247,26 +279,43 @@ class World:
 
     def _uplink_mode(self, t: int) -> None:
         st = self.station
-        if st["c2_link"] != "up":
+        if not self.link_up():
             return
         self.pil_cnt = (self.pil_cnt + 1) & 0xFF
+        mode = "DIRECT" if self.faults and self.faults.disengage else st["mode"]
         self._send(t, [
             (_PILOT_MODE.frame_id, _PILOT_MODE.encode(
-                MODE_CODES[st["mode"]], LAT_MODE_CODES[st["lat_mode"]],
+                MODE_CODES[mode], LAT_MODE_CODES[st["lat_mode"]],
                 VERT_MODE_CODES[st["vert_mode"]], self.pil_cnt)),
             (_PILOT_TARGETS.frame_id, _PILOT_TARGETS.encode(
                 st["heading_deg"] % 360.0, st["altitude_ft"], st["airspeed_kt"], st["vs_fpm"])),
         ])
 
+    def _scripted(self) -> bool:
+        """The script flies the stick itself: it asks for DIRECT and has given a stick input
+        since it last changed the mode. Otherwise the pilot model may fly it."""
+        return self._stick_scripted and self.station["mode"] == "DIRECT"
+
     def _uplink_stick(self, t: int) -> None:
         st = self.station
-        if st["c2_link"] != "up":
+        up = self.link_up()
+        pm = self.pilot_model.stick(t, st, self._scripted(), up)
+        if len(self.pilot_model.events) != self._pm_done:
+            for te, f in self.pilot_model.events[self._pm_done:]:
+                self.event("pilot", "pilot_model", t_ns=te, **f)
+            self._pm_done = len(self.pilot_model.events)
+        if not up:
             return
         s = st["stick"]
         thr = s["throttle"] if s["throttle"] is not None else self.trim["thr"]
+        if pm is None:
+            pitch, roll = s["pitch"], s["roll"]
+        else:
+            pitch, roll = pm[0], pm[1]
+            thr = min(max(thr + pm[2], 0.0), 1.0)
         self.stk_cnt = (self.stk_cnt + 1) & 0xF
         self._send(t, [(_PILOT_STICK.frame_id, _PILOT_STICK.encode(
-            s["pitch"], s["roll"], s["yaw"], thr, self.stk_cnt))])
+            pitch, roll, s["yaw"], thr, self.stk_cnt))])
 
     def _truth(self, t: int) -> None:
         rec = self.truth()
@@ -282,7 +331,8 @@ class World:
     # -- frames in -----------------------------------------------------------------------
     def _frames(self, frames) -> None:
         rcv = self.received
-        link_up = self.station["c2_link"] == "up"
+        link_up = self.link_up()
+        pm = self.pilot_model if self.pilot_model.enabled else None
         for f in frames:
             fid = f.id
             m = BY_ID.get(fid)
@@ -293,11 +343,27 @@ class World:
                 e, ai, ru, th, _cnt = a[1](f.data)
                 self.act.command(a[0], f.t_ns, (e, ai, ru, th))
                 continue
+            if not link_up:
+                continue
             s = _FCS_STATUS.get(fid)
-            if s is not None and link_up:
+            if s is not None:
                 v = s[1](f.data)
                 self.fcs_status[s[0]] = (f.t_ns, v[0], v[2])
                 self.fcs_last = (v[0], v[2])
+                if pm is not None:
+                    pm.status(s[0], f.t_ns, v[0], v[2], v[3], v[8], v[9])
+                continue
+            if pm is None:
+                continue
+            n = _NAV_POS.get(fid)
+            if n is not None:
+                lat, lon = n[1](f.data)
+                pm.nav_pos(n[0], f.t_ns, lat, lon)
+                continue
+            n = _NAV_DATA.get(fid)
+            if n is not None:
+                alt, wdir, wspd, _gs = n[1](f.data)
+                pm.nav_data(n[0], f.t_ns, alt, wdir, wspd)
 
     # -- physics -------------------------------------------------------------------------
     def advance(self, t: int) -> None:
@@ -372,7 +438,7 @@ class World:
                     for tk in tasks:
                         if tk[0] == s:
                             tk[2](s)
-                            tk[0] = self._next_event_t() if tk[1] == 0 else s + tk[1]
+                            tk[0] = tk[3]() if tk[1] == 0 else s + tk[1]
                     next_due = min(tk[0] for tk in tasks)
                 self.advance(t_until)
                 self.t_end = t_until
@@ -424,6 +490,13 @@ class World:
             "channels": self.opts.channels or 1,
             "vote": self._vote_summary(),
         }
+        # only when used: a run without them writes the file it always wrote
+        if self.faults is not None:
+            summary["faults"] = self.faults.summary()
+        if self.opts.test_switches:
+            summary["test_switches"] = list(self.opts.test_switches)
+        if self.pilot_model.events:
+            summary["pilot_model"] = [{"t_ns": t, **f} for t, f in self.pilot_model.events]
         (self.run_dir / "world.json").write_text(json.dumps(summary, indent=1) + "\n")
         emu = self.t_end / NS
         print(f"imaworld: {emu:.1f} s emulated, {self.n} steps, {wall_s:.2f} s wall"

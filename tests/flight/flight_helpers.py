@@ -1,8 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Helpers of the flight tests: a system with a stand-in mission manager, failure dumps."""
+"""Helpers of the flight tests: a system with a stand-in mission manager, world faults, the
+downlink and the world's events, failure dumps."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import shutil
 import warnings
@@ -93,3 +95,35 @@ def fly_unless_host_stalled(fly, run_dir, name: str):
         shutil.rmtree(run_dir)
         result = fly()
     return result
+
+
+@contextlib.contextmanager
+def world_faults(*specs: str):
+    """Flights launched inside get `--fault SPEC` on the world's command line. The launcher
+    has no option for them yet; this adds them to the plan it makes (only in these tests)."""
+    from ima.launch import commands
+
+    plan = commands.plan
+
+    def with_faults(*args, **kw):
+        p = plan(*args, **kw)
+        for s in specs:
+            p.world += ["--fault", s]
+        return p
+
+    commands.plan = with_faults
+    try:
+        yield
+    finally:
+        commands.plan = plan
+
+
+def status_frames(f) -> list[tuple]:
+    """(t, mode, fallback, nav flags) of each FCS_STATUS_A frame on the bus."""
+    return [(t, str(d["FCS_MODE_A"]), str(d["FCS_FALLBACK_A"]), int(d["FCS_NAV_FLAGS_A"]))
+            for t, d in f.can_frames("FCS_STATUS_A")]
+
+
+def world_events(f, kind: str) -> list[dict]:
+    return [e for e in (json.loads(x) for x in (f.run_dir / "world.jsonl").read_text()
+                        .splitlines()) if e["kind"] == kind]

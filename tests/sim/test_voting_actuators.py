@@ -340,3 +340,24 @@ def test_world_command_line_refuses_bad_voting_options(tmp_path, args, message):
                         str(PILOTS / "hold.yaml"), *args],
                        capture_output=True, text=True, timeout=60)
     assert p.returncode == 2 and message in p.stderr, p.stderr
+
+
+def test_world_test_switch_no_vote_out_never_votes_a_channel_out(local_world):
+    """Test-only: with no-vote-out a biased replica stays in the vote (the median still masks
+    it), so an oracle expecting it voted out must fail."""
+    def faulty(ch, t, trim):
+        return (trim[0] + 0.3,) + trim[1:] if ch == 1 and t >= 1 * NS else trim
+
+    r = fly3(local_world, 3, faulty, channels=3, test_switches=("no-vote-out",))
+    act = [e for e in r.events() if e["src"] == "actuators"]
+    assert not [e for e in act if e["kind"] == "voted_out"]
+    assert [(e["status"], e["used"]) for e in act if e["kind"] == "vote"] == [
+        ("MID3", ["A", "B", "C"])]
+    s = r.summary()
+    assert s["vote"]["voted_out"] == [] and s["test_switches"] == ["no-vote-out"]
+    assert r.world.act.selector.voter.failed == 0
+    from imaworld.__main__ import build_parser
+
+    assert build_parser().parse_args(["--bus", "b", "--run-dir", "r", "--pilot", "p",
+                                      "--test-switch", "no-vote-out"]).test_switch == \
+        ["no-vote-out"]

@@ -28,6 +28,8 @@ enum rpas_fallback {
     RPAS_FB_MISSION_STALE = 2, /* MISSION/CONTINGENCY targets stale: AUTOPILOT holding */
     RPAS_FB_NAV_INVALID = 3,   /* no usable navigation solution */
     RPAS_FB_NO_TARGETS = 4,    /* AUTOPILOT asked before any target arrived: holding */
+    RPAS_FB_SENSOR_LOST = 5,   /* attitude (AHRS) or air data unusable: autopilot disengaged,
+                                  DIRECT for the remote pilot (C2 up) */
 };
 
 /* io -> nav_fcs: port GPS_IN (5 Hz) */

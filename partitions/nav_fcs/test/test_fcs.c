@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Unit tests of the nav_fcs flight-control core: modes and fallbacks, limits, anti-windup,
- * bumpless entry, envelope protection, angle wrapping, determinism. */
+ * bumpless entry, envelope protection, angle wrapping, determinism; the degraded modes (attitude
+ * or air data unusable). */
 #include <string.h>
 
 #include "fcs.h"
@@ -16,6 +17,7 @@ typedef struct {
     rpas_act_cmd_msg_t cmd;
     rpas_fcs_status_msg_t st;
     int64_t now;
+    bool stick; /* the station sends its stick in every mode (it does: PILOT_STICK at 20 Hz) */
 } rig_t;
 
 /* Level flight at 3000 ft, 100 kt, heading 090; pilot link up asking for mode. */
@@ -52,7 +54,7 @@ static void step(rig_t *r)
     r->now += 50 * MS;
     if (r->in.pilot_ok) {
         r->in.pilot.t_ns = r->now;
-        if (r->in.pilot.mode == RPAS_MODE_DIRECT)
+        if (r->in.pilot.mode == RPAS_MODE_DIRECT || r->stick)
             r->in.pilot.t_stick_ns = r->now;
     }
     r->nav.t_ns = r->now;
@@ -532,6 +534,165 @@ static void test_bad_inputs_stay_finite(void)
     CHECK(cmd_in_range(&r.cmd));
 }
 
+/* Asked AUTOPILOT, link up (the station's stick comes at 20 Hz in every mode). */
+static void rig_degraded(rig_t *r)
+{
+    rig_init(r, RPAS_MODE_AUTOPILOT);
+    set_pilot_targets(r, 200.0, 3500.0, 105.0);
+    r->stick = true;
+    r->in.pilot.stk_thr = 0.66;
+    r->in.pilot.stk_roll = 0.1;
+    steps(r, 40);
+}
+
+/* Attitude lost under AUTOPILOT: DIRECT for the pilot, SENSOR_LOST; back to the autopilot,
+ * bumpless, once the attitude has been good for sensor_reengage_s. */
+static void test_attitude_lost_reverts_to_direct(void)
+{
+    rig_t r;
+    rig_degraded(&r);
+    CHECK(r.st.mode == RPAS_MODE_AUTOPILOT && r.st.fallback == RPAS_FB_NONE);
+    double elev_ap = r.cmd.elev;
+    r.nav.flags &= ~(uint32_t)RPAS_NAV_AHRS;
+    step(&r);
+    CHECK(r.st.mode == RPAS_MODE_DIRECT);
+    CHECK(r.st.req_mode == RPAS_MODE_AUTOPILOT);
+    CHECK(r.st.fallback == RPAS_FB_SENSOR_LOST);
+    CHECK(fabs(r.cmd.elev - elev_ap) < 0.05); /* the stick fades in from the last command */
+    steps(&r, 25);
+    CHECK_NEAR(r.cmd.ail, 0.1, 1e-12); /* the stick, no protection without attitude */
+    CHECK_NEAR(r.cmd.thr, 0.66, 1e-12);
+    CHECK(r.st.env_flags == 0);
+    CHECK_NEAR(r.st.tgt_hdg_deg, 200.0, 1e-9); /* the targets it flew stay on the downlink */
+    /* the attitude comes back: DIRECT for 2 s more, then the pilot's AUTOPILOT */
+    r.nav.flags |= RPAS_NAV_AHRS;
+    steps(&r, 40); /* good since the first of them: 1.95 s at the last */
+    CHECK(r.st.mode == RPAS_MODE_DIRECT && r.st.fallback == RPAS_FB_SENSOR_LOST);
+    double ail = r.cmd.ail, thr = r.cmd.thr;
+    step(&r);
+    CHECK(r.st.mode == RPAS_MODE_AUTOPILOT && r.st.fallback == RPAS_FB_NONE);
+    CHECK_NEAR(r.st.tgt_hdg_deg, 200.0, 1e-9);
+    CHECK_NEAR(r.cmd.ail, ail, 0.03);
+    CHECK_NEAR(r.cmd.thr, thr, 0.03);
+}
+
+/* Air data lost: DIRECT too, with the attitude protection still acting. */
+static void test_air_data_lost_reverts_to_direct(void)
+{
+    rig_t r;
+    rig_degraded(&r);
+    r.nav.flags &= ~(uint32_t)RPAS_NAV_AIR;
+    r.in.pilot.stk_roll = 1.0;
+    steps(&r, 30);
+    CHECK(r.st.mode == RPAS_MODE_DIRECT && r.st.fallback == RPAS_FB_SENSOR_LOST);
+    r.nav.roll_deg = 50.0;
+    step(&r);
+    CHECK(r.cmd.ail < 0.0);
+    CHECK(r.st.env_flags & FCS_ENV_BANK);
+    /* a sensor that comes and goes every 0.5 s keeps DIRECT: no toggling at its rate */
+    r.nav.roll_deg = 0.0;
+    for (int i = 0; i < 12; i++) {
+        if (i % 2)
+            r.nav.flags |= RPAS_NAV_AIR;
+        else
+            r.nav.flags &= ~(uint32_t)RPAS_NAV_AIR;
+        steps(&r, 10);
+        CHECK(r.st.mode == RPAS_MODE_DIRECT);
+    }
+}
+
+/* Degraded without a pilot: no DIRECT to hand over. Air data lost: AUTOPILOT holding the
+ * state captured (C2_LOST, as DIRECT without link); attitude lost: the attitude-free commands.
+ * The link back: DIRECT for the pilot. */
+static void test_degraded_without_c2(void)
+{
+    rig_t r;
+    rig_degraded(&r);
+    r.nav.flags &= ~(uint32_t)RPAS_NAV_AIR;
+    r.nav.hdg_deg = 133.0;
+    r.nav.alt_ft = 3210.0;
+    r.in.pilot_ok = false;
+    step(&r);
+    CHECK(r.st.mode == RPAS_MODE_AUTOPILOT && r.st.fallback == RPAS_FB_C2_LOST);
+    CHECK_NEAR(r.st.tgt_hdg_deg, 133.0, 1e-9);
+    CHECK_NEAR(r.st.tgt_alt_ft, 3210.0, 1e-9);
+    steps(&r, 20);
+    CHECK(cmd_in_range(&r.cmd));
+    r.nav.flags &= ~(uint32_t)RPAS_NAV_AHRS;
+    step(&r);
+    CHECK(r.st.mode == RPAS_MODE_AUTOPILOT && r.st.fallback == RPAS_FB_NAV_INVALID);
+    CHECK_NEAR(r.cmd.ail, 0.0, 0.0);
+    r.in.pilot_ok = true;
+    step(&r);
+    CHECK(r.st.mode == RPAS_MODE_DIRECT && r.st.fallback == RPAS_FB_SENSOR_LOST);
+    /* the stick stops while the link is up: the same as no link */
+    r.stick = false;
+    r.in.pilot.t_stick_ns = r.now - 2000 * MS;
+    r.nav.flags |= RPAS_NAV_AHRS;
+    step(&r);
+    CHECK(r.st.mode == RPAS_MODE_AUTOPILOT && r.st.fallback == RPAS_FB_C2_LOST);
+}
+
+/* DIRECT asked: a lost sensor changes nothing but the protection it feeds. */
+static void test_degraded_in_direct(void)
+{
+    rig_t r;
+    rig_init(&r, RPAS_MODE_DIRECT);
+    r.in.pilot.stk_roll = 0.2;
+    steps(&r, 30);
+    r.nav.flags &= ~(uint32_t)(RPAS_NAV_AHRS | RPAS_NAV_AIR);
+    steps(&r, 5);
+    CHECK(r.st.mode == RPAS_MODE_DIRECT && r.st.fallback == RPAS_FB_NONE);
+    CHECK_NEAR(r.cmd.ail, 0.2, 1e-12);
+    /* the link lost too: the attitude-free commands (nothing else can fly) */
+    r.in.pilot_ok = false;
+    step(&r);
+    CHECK(r.st.mode == RPAS_MODE_AUTOPILOT && r.st.fallback == RPAS_FB_NAV_INVALID);
+}
+
+/* At the start a sensor not yet heard is not lost until sensor_wait_s; one never heard is. */
+static void test_degraded_at_start(void)
+{
+    rig_t r;
+    rig_init(&r, RPAS_MODE_AUTOPILOT);
+    set_pilot_targets(&r, 90.0, 3000.0, 100.0);
+    r.stick = true;
+    r.nav.flags = RPAS_NAV_GPS | RPAS_NAV_AHRS; /* air data a little late */
+    steps(&r, 10);
+    CHECK(r.st.mode == RPAS_MODE_AUTOPILOT && r.st.fallback == RPAS_FB_NONE);
+    r.nav.flags |= RPAS_NAV_AIR;
+    steps(&r, 40);
+    CHECK(r.st.mode == RPAS_MODE_AUTOPILOT && r.st.fallback == RPAS_FB_NONE);
+
+    rig_init(&r, RPAS_MODE_AUTOPILOT);
+    set_pilot_targets(&r, 90.0, 3000.0, 100.0);
+    r.stick = true;
+    r.nav.flags = RPAS_NAV_GPS | RPAS_NAV_AIR; /* no attitude, ever */
+    steps(&r, 20); /* 0.95 s after the first step */
+    CHECK(r.st.mode == RPAS_MODE_INIT && r.st.fallback == RPAS_FB_NAV_INVALID);
+    step(&r);
+    CHECK(r.st.mode == RPAS_MODE_DIRECT && r.st.fallback == RPAS_FB_SENSOR_LOST);
+}
+
+/* MISSION: a lost attitude hands the aircraft to the pilot; the mission resumes after. */
+static void test_degraded_in_mission(void)
+{
+    rig_t r;
+    rig_init(&r, RPAS_MODE_MISSION);
+    r.stick = true;
+    set_mission(&r, RPAS_MODE_MISSION, 45.0, 3500.0, 95.0);
+    mission_steps(&r, 10, true);
+    CHECK(r.st.mode == RPAS_MODE_MISSION);
+    r.nav.flags &= ~(uint32_t)RPAS_NAV_AHRS;
+    mission_steps(&r, 10, true);
+    CHECK(r.st.mode == RPAS_MODE_DIRECT && r.st.fallback == RPAS_FB_SENSOR_LOST);
+    CHECK(r.st.req_mode == RPAS_MODE_MISSION);
+    r.nav.flags |= RPAS_NAV_AHRS;
+    mission_steps(&r, 41, true);
+    CHECK(r.st.mode == RPAS_MODE_MISSION && r.st.fallback == RPAS_FB_NONE);
+    CHECK_NEAR(r.st.tgt_hdg_deg, 45.0, 1e-9);
+}
+
 /* Same inputs, same outputs: two replicas agree bit for bit. */
 static void test_deterministic_replicas(void)
 {
@@ -566,5 +727,11 @@ int main(void)
     RUN(test_speed_protection_autopilot);
     RUN(test_bad_inputs_stay_finite);
     RUN(test_deterministic_replicas);
+    RUN(test_attitude_lost_reverts_to_direct);
+    RUN(test_air_data_lost_reverts_to_direct);
+    RUN(test_degraded_without_c2);
+    RUN(test_degraded_in_direct);
+    RUN(test_degraded_at_start);
+    RUN(test_degraded_in_mission);
     return UNIT_RESULT();
 }

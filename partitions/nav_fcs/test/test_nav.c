@@ -68,6 +68,7 @@ static void sim_step(sim_t *s, int64_t now, double dt, bool gps_frozen)
     in->ahrs.pitch_deg = 2.0;
     in->ahrs.hdg_deg = s->hdg_deg;
     in->ahrs.az_g = -1.0;
+    in->ahrs.r_dps = 0.001 * (double)(s->ahrs_seq % 1000); /* an AHRS is never constant */
     in->ahrs_ok = true;
     in->air.t_ns = now;
     in->air.seq = ++s->air_seq;
@@ -298,6 +299,38 @@ static void test_ahrs_and_air_monitoring(void)
     CHECK(!(o.flags & RPAS_NAV_AIR));
 }
 
+/* An AHRS stuck behind a live counter: every value repeats, the counter and the status run on.
+ * Dropped after ahrs_stuck_s (0.5 s), back as soon as the values move again. */
+static void test_stuck_ahrs(void)
+{
+    nav_t nav;
+    nav_init(&nav, NULL);
+    sim_t s;
+    sim_init(&s, 90.0, 0.0, 0.0);
+    rpas_nav_msg_t o;
+    int64_t now = 0;
+    fly(&nav, &s, &now, 2.0, false, &o);
+    CHECK(o.flags & RPAS_NAV_AHRS);
+    rpas_ahrs_msg_t stuck = s.in.ahrs;
+    int valid_for = 0;
+    for (int i = 0; i < 20; i++) {
+        now += 50 * MS;
+        sim_step(&s, now, 0.05, false);
+        uint32_t seq = s.in.ahrs.seq;
+        s.in.ahrs = stuck;
+        s.in.ahrs.seq = seq; /* the counter keeps running */
+        s.in.ahrs.t_ns = now;
+        nav_update(&nav, &s.in, now, &o);
+        if (o.flags & RPAS_NAV_AHRS)
+            valid_for++;
+    }
+    CHECK(valid_for == 9); /* 0.45 s after the last change: still good; at 0.5 s: stuck */
+    CHECK(!(o.flags & RPAS_NAV_AHRS));
+    CHECK(o.flags & RPAS_NAV_GPS);
+    fly(&nav, &s, &now, 0.05, false, &o);
+    CHECK(o.flags & RPAS_NAV_AHRS);
+}
+
 int main(void)
 {
     RUN(test_all_sources_valid);
@@ -307,5 +340,6 @@ int main(void)
     RUN(test_stale_or_bad_gps_rejected);
     RUN(test_no_dead_reckoning_without_a_first_fix);
     RUN(test_ahrs_and_air_monitoring);
+    RUN(test_stuck_ahrs);
     return UNIT_RESULT();
 }

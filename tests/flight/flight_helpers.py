@@ -4,7 +4,6 @@ downlink and the world's events, failure dumps."""
 
 from __future__ import annotations
 
-import contextlib
 import json
 import shutil
 import warnings
@@ -97,25 +96,11 @@ def fly_unless_host_stalled(fly, run_dir, name: str):
     return result
 
 
-@contextlib.contextmanager
-def world_faults(*specs: str):
-    """Flights launched inside get `--fault SPEC` on the world's command line. The launcher
-    has no option for them yet; this adds them to the plan it makes (only in these tests)."""
-    from ima.launch import commands
+def fault(spec: str, fid: str):
+    """A fault in the short form (faultinject.grammar), for LaunchOptions.faults."""
+    from faultinject import grammar
 
-    plan = commands.plan
-
-    def with_faults(*args, **kw):
-        p = plan(*args, **kw)
-        for s in specs:
-            p.world += ["--fault", s]
-        return p
-
-    commands.plan = with_faults
-    try:
-        yield
-    finally:
-        commands.plan = plan
+    return grammar.parse(spec, fid)
 
 
 def status_frames(f) -> list[tuple]:

@@ -7,7 +7,7 @@ does; an autopilot disengagement from the station is flown the same way."""
 from __future__ import annotations
 
 import pytest
-from flight_helpers import PILOTS, dump, status_frames, world_events, world_faults
+from flight_helpers import PILOTS, dump, fault, status_frames, world_events
 
 # What the pilot model keeps in light turbulence with a 10 kt wind, flying from the telemetry
 # alone (no attitude on the downlink): the envelope this test states.
@@ -34,16 +34,14 @@ def _within(rows, alt_ft, hdg_deg):
 
 @pytest.fixture(scope="module")
 def ahrs_stuck(flights):
-    with world_faults("ahrs_stuck:fid=ahrs1,at=20s,until=70s"):
-        return flights.fly("ahrs_stuck", duration_s=90, seed=3, turbulence="light", wind_kt=10,
-                           pilot=PILOTS / "hold.yaml")
+    return flights.fly("ahrs_stuck", duration_s=90, seed=3, turbulence="light", wind_kt=10,
+                       pilot=PILOTS / "hold.yaml", faults=[fault("world:ahrs_stuck@20~50", "ahrs1")])
 
 
 @pytest.fixture(scope="module")
 def disengage(flights):
-    with world_faults("ap_disengage:fid=ap1,at=10s,until=45s"):
-        return flights.fly("disengage", duration_s=60, seed=4, turbulence="none", wind_kt=10,
-                           pilot=PILOTS / "hold.yaml")
+    return flights.fly("disengage", duration_s=60, seed=4, turbulence="none", wind_kt=10,
+                       pilot=PILOTS / "hold.yaml", faults=[fault("world:ap_disengage@10~35", "ap1")])
 
 
 def test_a_stuck_ahrs_hands_the_aircraft_to_the_pilot_and_back(ahrs_stuck):

@@ -13,7 +13,8 @@ from typing import Any
 
 DEFAULT_SETTLE_S = 60.0
 MODE_NAMES = {0: "INIT", 1: "DIRECT", 2: "AUTOPILOT", 3: "MISSION", 4: "CONTINGENCY"}
-FALLBACK_NAMES = {0: "NONE", 1: "C2_LOST", 2: "MISSION_STALE", 3: "NAV_INVALID", 4: "NO_TARGETS"}
+FALLBACK_NAMES = {0: "NONE", 1: "C2_LOST", 2: "MISSION_STALE", 3: "NAV_INVALID", 4: "NO_TARGETS",
+                  5: "SENSOR_LOST"}  # as the DBC's FCS_FALLBACK value table
 
 
 @dataclass(frozen=True)

@@ -140,9 +140,14 @@ def _evidence(ctx: Context, inj: Injection, kind: str, t0: int) -> int | None:
         return _frames_differ(ctx, (ACT_CMD_A + k - 1,), t0)
     if kind == "can_error":
         return _first(ctx.run.bus_kind("can_error", "error_frame", "bus_off"), t0, lambda e: True)
-    if kind == "frames_missing":
-        return _first(ctx.run.bus_kind("can_drop", "rx_drop"), t0, lambda e: True)
-    if kind in ("frames_late", "frames_duplicated", "frames_flood"):
+    if kind == "frames_missing":  # the bus's wire: a frame that never reached it, or a receiver
+        return _first(ctx.run.bus_kind("can_drop", "can_rx_drop"), t0,
+                      lambda e: e.get("fid") == inj.fid)
+    if kind == "frames_duplicated":
+        return _first(ctx.run.frames, t0, lambda e: e.get("duplicate") is True)
+    if kind == "frames_flood":  # a babbler's frames on the wire
+        return _first(ctx.run.frames, t0, lambda e: e.get("fid") == inj.fid)
+    if kind == "frames_late":
         return _frames_differ(ctx, tuple({e["id"] for e in ctx.run.frames}), t0)
     if kind == "dds_missing":
         others = [e for n, evs in ctx.run.dds.items() if n != node for e in evs]

@@ -64,7 +64,11 @@ def timing(f: Fault) -> str:
 
 
 def _params(f: Fault, skip: tuple[str, ...] = ()) -> list[str]:
-    return [f"{k}={v}" for k, v in f.params.items() if k not in skip]
+    """The class's parameters, its defaults filled in (the injectors have none of their own
+    for what the catalogue defines)."""
+    fc = catalogue.get(f.cls)
+    given = {k: p.default for k, p in fc.params.items() if p.default is not None} | f.params
+    return [f"{k}={v}" for k, v in given.items() if k not in skip]
 
 
 def check_target(system, f: Fault) -> None:

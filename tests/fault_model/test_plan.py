@@ -40,7 +40,9 @@ def test_each_injector_gets_its_words(triplex) -> None:
     assert p.ske["node3"] == [
         "--fault", "corrupt_output:fid=f2,at=10000000000,period=4000000000,on=2000000000,"
         "partition=nav_fcs,port=ACT_CMD_OUT"]
-    assert p.io == {"node1": ["--fault=wrong_output:fid=f3,at=30000000000,mode=hardover,value=-1.0"]}
+    # the class's defaults are filled in: the injectors have none of their own
+    assert p.io == {"node1": ["--fault=wrong_output:fid=f3,at=30000000000,mode=hardover,axis=elev,"
+                              "value=-1.0,period_osc=2s,seed=1"]}
     assert p.dds == {"node2": ["--fault", "dds_delay:fid=f4,at=20000000000,frames=3"]}
     assert p.bus == ["--fault", "can_bus_off:fid=f5,at=40000000000,client=node3/io"]
     assert p.world == ["--fault", "gps_loss:fid=f6,at=50000000000,until=80000000000"]

@@ -38,12 +38,18 @@ def with_mission_feed(system: Path, dest: Path, feed: dict) -> Path:
         "period_s": 0.05,
         "processes": [{"name": "feed", "period_s": 0.05, "stack": 65536, "priority": 10}],
         "ports": [{"name": "MISSION_OUT", "direction": "source", "kind": "sampling",
-                   "size": 56, "refresh_s": 0.5, "message": "rpas_mission_msg_t"}],
+                   "size": 56, "refresh_s": 0.5, "message": "rpas_mission_msg_t"},
+                  # its log, a queuing channel to itself (a target for queuing faults)
+                  {"name": "FEED_LOG_OUT", "direction": "source", "kind": "queuing",
+                   "size": 8, "max_messages": 8},
+                  {"name": "FEED_LOG_IN", "direction": "destination", "kind": "queuing",
+                   "size": 8, "max_messages": 8}],
         "memory": [{"type": "DATA", "size": 0x2000000, "access": "READ_WRITE"}]}]
     doc["schedule"] = dict(doc["schedule"], windows=list(doc["schedule"]["windows"]) +
                            [FEED_WINDOW])
     doc["channels"] = dict(doc["channels"], intra_node=list(doc["channels"]["intra_node"]) + [
-        {"name": "mission", "from": "mission_feed.MISSION_OUT", "to": "nav_fcs.MISSION_IN"}])
+        {"name": "mission", "from": "mission_feed.MISSION_OUT", "to": "nav_fcs.MISSION_IN"},
+        {"name": "feed_log", "from": "mission_feed.FEED_LOG_OUT", "to": "mission_feed.FEED_LOG_IN"}])
     dest.parent.mkdir(parents=True, exist_ok=True)
     header = (f"# Generated from {system} with the stand-in mission feed — do not edit.\n"
               "# SPDX-License-Identifier: Apache-2.0\n")

@@ -4,6 +4,7 @@ injector, target, parameters, and what a run of it must show."""
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,8 +25,14 @@ OUTCOMES = ("not_activated", "masked", "detected_recovered", "detected_degraded"
             "undetected_benign", "undetected_hazardous")
 EVIDENCE = ("hm", "overrun", "port_silent", "port_changed", "frames_stopped", "frames_changed",
             "can_error", "frames_missing", "frames_late", "frames_duplicated", "frames_flood",
-            "dds_missing", "sensor_frames", "truth_surface", "downlink_mode", "module_reset",
-            "app_report")
+            "dds_missing", "sensor_frames", "pilot_frames", "truth_surface", "downlink_mode",
+            "module_reset", "app_report")
+ASKED_MODES = ("DIRECT", "AUTOPILOT", "MISSION")
+# What a case may change: the expectations that depend on where and when the fault acts.
+CASE_KEYS = ("evidence", "detect", "latency_ms", "mode", "masked", "outcomes")
+# What a case's `when` may name: the mode the pilot asks for at the injection, the target
+# partition, and whether the fault is common-mode (every node at once).
+WHEN_KEYS = ("asked", "partition", "common_mode")
 PARAM_TYPES = ("number", "int", "time", "name", "choice")
 
 
@@ -54,6 +61,18 @@ class FaultClass:
     mode: dict | None = None
     known_limit: dict | None = None
     params: dict[str, Param] = field(default_factory=dict)
+    # (when, this class with the case's expectations): the first case that holds decides
+    cases: tuple[tuple[dict, FaultClass], ...] = ()
+
+    def case(self, asked: str | None, partition: str | None, common_mode: bool) -> FaultClass:
+        """The class's expectations for a fault of it: those of the first of the catalogue's
+        `cases` whose `when` holds (the mode the pilot asks for at the injection, the target
+        partition, common mode), or the class's own."""
+        facts = {"asked": asked, "partition": partition, "common_mode": common_mode}
+        for when, fc in self.cases:
+            if all(facts[k] == v for k, v in when.items()):
+                return fc
+        return self
 
     def variant(self, redundant: bool) -> str:
         return "redundant" if redundant else "single"
@@ -102,7 +121,7 @@ def _params(where: str, spec: dict) -> dict[str, Param]:
 def _load_class(name: str, c: dict) -> FaultClass:
     where = f"classes.{name}"
     known = {"layer", "injector", "target", "params", "evidence", "hm_error", "detect",
-             "latency_ms", "mode", "masked", "outcomes", "known_limit"}
+             "latency_ms", "mode", "masked", "outcomes", "known_limit", "cases"}
     extra = set(c) - known
     if extra:
         raise _fail(where, f"unknown keys {sorted(extra)}")
@@ -112,7 +131,7 @@ def _load_class(name: str, c: dict) -> FaultClass:
                               or not limit.get("reason")):
         raise _fail(f"{where}.known_limit", "needs applies (always|single|common_mode) and reason")
     hm_error = c.get("hm_error")
-    return FaultClass(
+    fc = FaultClass(
         name=name,
         layer=_choice(f"{where}.layer", c.get("layer"), LAYERS),
         injector=_choice(f"{where}.injector", c.get("injector"), INJECTORS),
@@ -129,6 +148,21 @@ def _load_class(name: str, c: dict) -> FaultClass:
         known_limit=limit,
         params=_params(f"{where}.params", c.get("params")),
     )
+    cases = []
+    for i, case in enumerate(c.get("cases") or []):
+        at = f"{where}.cases[{i}]"
+        when = (case or {}).get("when")
+        if not isinstance(when, dict) or not when or set(when) - set(WHEN_KEYS):
+            raise _fail(at, f"needs `when` with any of {', '.join(WHEN_KEYS)}")
+        if "asked" in when:
+            _choice(f"{at}.when.asked", when["asked"], ASKED_MODES)
+        bad = set(case) - set(CASE_KEYS) - {"when"}
+        if bad:
+            raise _fail(at, f"a case may change only {', '.join(CASE_KEYS)}, not {sorted(bad)}")
+        merged = {k: v for k, v in c.items() if k != "cases"}
+        merged.update({k: v for k, v in case.items() if k != "when"})
+        cases.append((dict(when), _load_class(name, merged)))
+    return dataclasses.replace(fc, cases=tuple(cases)) if cases else fc
 
 
 @functools.cache

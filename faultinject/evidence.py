@@ -7,12 +7,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from faultinject import catalogue
 from faultinject.context import Context
 from faultinject.plan import Injection
 
 SENSOR_IDS = {"gps": (0x9100190, 0x9100194), "ahrs": (0x9100320, 0x9100324, 0x9100328),
               "air": (0x91004B0,)}
+PILOT_IDS = (0x8B807D0, 0x8B807D4, 0x8B807D8)  # the C2 uplink: PILOT_MODE, _TARGETS, _STICK
 ACT_CMD_A = 0x8D80640
 
 
@@ -77,20 +77,26 @@ def _frames_differ(ctx: Context, ids: tuple[int, ...], t0: int) -> int | None:
 
 
 def _io_frames_stop(ctx: Context, node: str | None, t0: int) -> int | None:
-    """When the node's io stopped sending (its last frame before the end of the run)."""
+    """When a frame the node's io sent in the golden run at or after t0 did not reach the wire
+    (without a golden run: its last frame, if it stopped sending before the end)."""
     if node is None:
         return None
     name = f"{node}/io"
-    mine = [e["t_ns"] for e in ctx.run.frames if e.get("from") == name]
-    after = [t for t in mine if t >= t0]
+    mine = [(e["t_ns"], e["id"]) for e in ctx.run.frames if e.get("from") == name]
+    if ctx.golden is not None:
+        sent = {x for x in mine if x[0] >= t0}
+        return next((t for t, i in ((e["t_ns"], e["id"]) for e in ctx.golden.frames
+                                    if e.get("from") == name and e["t_ns"] >= t0)
+                     if (t, i) not in sent), None)
+    after = [t for t, _ in mine if t >= t0]
     end = ctx.run.frames[-1]["t_ns"] if ctx.run.frames else 0
     if not mine or (after and after[-1] > end - 200_000_000):
         return None  # still sending near the end
-    return max(t0, mine[-1])
+    return max(t0, mine[-1][0])
 
 
 def check(ctx: Context, inj: Injection) -> Confirmation:
-    fc = catalogue.get(inj.fault.cls)
+    fc = ctx.fault_class(inj.fault)
     t0 = inj.fault.at_ns
     applied, refused = _applied(ctx, inj)
     if inj.fault.cls in ("node_crash", "node_freeze"):
@@ -157,6 +163,8 @@ def _evidence(ctx: Context, inj: Injection, kind: str, t0: int) -> int | None:
                       and e.get("peer") == node)
     if kind == "sensor_frames":
         return _frames_differ(ctx, tuple(i for ids in SENSOR_IDS.values() for i in ids), t0)
+    if kind == "pilot_frames":
+        return _frames_differ(ctx, PILOT_IDS, t0)
     if kind == "truth_surface":
         return _truth_differs(ctx, t0, ("elev", "ail", "rud", "thr"))
     if kind == "downlink_mode":

@@ -8,7 +8,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from faultinject import catalogue, detectors, hm_tables, oracles
+from faultinject import detectors, hm_tables, oracles
 from faultinject.context import Context
 from faultinject.evidence import Confirmation, check
 from faultinject.plan import Plan
@@ -113,7 +113,7 @@ def confirmation(ctx: Context, conf: list[Confirmation]) -> dict:
     text = [c.fid + (f"@{c.node}" if c.node else "") + f": {c.evidence}" for _, c in missing]
     if not missing:
         return {"verdict": "pass", "unconfirmed": []}
-    allowed = all("not_activated" in catalogue.get(inj.fault.cls).expected_outcomes(
+    allowed = all("not_activated" in ctx.fault_class(inj.fault).expected_outcomes(
         ctx.redundant) for inj, _ in missing)
     return {"verdict": "unconfirmed" if allowed else "fail", "unconfirmed": text}
 
@@ -138,7 +138,7 @@ def judge(run_dir: Path, golden_dir: Path | None, plan: Plan, system, duration_s
             if c.t_ns is not None:
                 detected.update(detectors.fired(ctx, inj, c.t_ns))
         confirmed = all(c.confirmed for _, c in mine)
-        fc = catalogue.get(f.cls)
+        fc = ctx.fault_class(f)
         outcome = _outcome(confirmed, bool(detected), bool(degraded), identical, env_left)
         expected = fc.expected_outcomes(ctx.redundant)
         outcomes.append(outcome)

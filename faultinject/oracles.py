@@ -5,7 +5,7 @@ says of itself. Each gives {"verdict": "pass" | "fail" | "n/a", ...its findings}
 
 from __future__ import annotations
 
-from faultinject import catalogue, detectors, hm_tables
+from faultinject import detectors, hm_tables
 from faultinject.context import Context
 from faultinject.evidence import Confirmation
 from faultinject.plan import Injection
@@ -16,6 +16,14 @@ ENVELOPE = {"bank_deg": 60.0, "pitch_up_deg": 25.0, "pitch_down_deg": -20.0,
 # How far a masked fault's flight may depart from the golden run's when the catalogue says
 # `tracking` (the truth cannot be bit-identical, and says why).
 TRACKING = {"alt_ft": 100.0, "airspeed_kt": 15.0, "heading_deg": 15.0}
+# The health monitor's errors that say a partition did not get its time: what another
+# partition's fault must never cause. (An error a partition reports of its data, such as a
+# replica's self-monitor seeing its output voted out, is detection, not interference.)
+TIMING_ERRORS = ("WINDOW_OVERRUN", "DEADLINE_MISSED")
+# Real-time runs: how far a partition's CPU time (measured on the host) may be from the golden
+# run's (a part of it, plus some per emulated second: the host's own noise), and the bound on
+# the p99 of its windows' start lateness (docs/fault-injection.md).
+REALTIME_TOLERANCE = {"cpu_rel": 0.5, "cpu_abs_ms_per_s": 0.5, "late_p99_ms": 2.0}
 
 
 def direct_targets(inj: Injection) -> set[tuple[str, str | None]]:
@@ -33,18 +41,47 @@ def _excluded(ctx: Context, node: str, partition: str) -> bool:
                for inj in ctx.plan.injections for n, p in direct_targets(inj))
 
 
+def _timing_events(ctx: Context, node: str, partition: str) -> list[dict]:
+    """The partition's overruns and timing errors the golden run does not have."""
+    found = []
+    for kind in ("overrun", "hm"):
+        def timing(e, kind=kind):
+            return e.get("partition") == partition and (
+                kind == "overrun" or e.get("error") in TIMING_ERRORS)
+        extra = [e for e in ctx.run.node_kind(node, kind) if timing(e)]
+        if len(extra) > len([e for e in ctx.golden.node_kind(node, kind) if timing(e)]):
+            found.append({"node": node, "partition": partition, kind: extra[0]})
+    return found
+
+
+def _p99(values: list[int]) -> int:
+    v = sorted(values)
+    return v[min(len(v) - 1, int(0.99 * len(v)))] if v else 0
+
+
 def temporal_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
     """Every partition but the targets gets each of its windows at its planned start, yields
     at the same time as in the golden run (the same work: its releases and time-outs), and has
-    no overrun nor HM event."""
+    no overrun nor timing error (TIMING_ERRORS) the golden run has not. In real time, where
+    no two runs yield at the same instants, it is judged on what the host measures instead:
+    each partition's CPU time within REALTIME_TOLERANCE of the golden run's, and the p99 of
+    its windows' start lateness within its bound."""
     if ctx.golden is None:
         return {"verdict": "n/a", "why": "no golden run"}
-    findings, checked = [], 0
+    realtime = ctx.run.realtime and ctx.golden.realtime
+    findings, checked, measured = [], 0, []
     for node in ctx.node_names:
         for p in ctx.system.partitions:
             if _excluded(ctx, node, p.name):
                 continue
             checked += 1
+            findings += _timing_events(ctx, node, p.name)
+            if realtime:
+                m = _realtime_check(ctx, node, p.name)
+                measured.append(m)
+                if m["verdict"] == "fail":
+                    findings.append(m)
+                continue
             run, gold = ctx.run.windows(node, p.name), ctx.golden.windows(node, p.name)
             if run != gold:
                 diff = next((i for i, (a, b) in enumerate(zip(run, gold, strict=False))
@@ -53,13 +90,32 @@ def temporal_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
                 want = gold[diff] if diff < len(gold) else None
                 findings.append({"node": node, "partition": p.name, "window": diff,
                                  "run": got, "golden": want})
-            for kind in ("overrun", "hm"):
-                extra = [e for e in ctx.run.node_kind(node, kind) if e.get("partition") == p.name]
-                if len(extra) > len([e for e in ctx.golden.node_kind(node, kind)
-                                     if e.get("partition") == p.name]):
-                    findings.append({"node": node, "partition": p.name, kind: extra[0]})
-    return {"verdict": "fail" if findings else "pass", "partitions_checked": checked,
-            "violations": findings[:10]}
+    out = {"verdict": "fail" if findings else "pass", "partitions_checked": checked,
+           "time": "realtime" if realtime else "emulated", "violations": findings[:10]}
+    if realtime:
+        out["tolerance"] = REALTIME_TOLERANCE
+        out["measured"] = measured
+    return out
+
+
+def _realtime_check(ctx: Context, node: str, partition: str) -> dict:
+    tol = REALTIME_TOLERANCE
+    cpu, gold_cpu = ctx.run.cpu_ns(node, partition), ctx.golden.cpu_ns(node, partition)
+    late = _p99(ctx.run.window_lateness(node, partition))
+    m = {"node": node, "partition": partition, "late_p99_ms": round(late / 1e6, 3)}
+    bad = []
+    if late > tol["late_p99_ms"] * 1e6:
+        bad.append("window-start lateness")
+    if cpu is not None and gold_cpu is not None:
+        allowed = tol["cpu_rel"] * gold_cpu + tol["cpu_abs_ms_per_s"] * 1e6 * ctx.duration_s
+        m.update(cpu_ms=round(cpu / 1e6, 3), golden_cpu_ms=round(gold_cpu / 1e6, 3),
+                 cpu_allowed_ms=round(allowed / 1e6, 3))
+        if abs(cpu - gold_cpu) > allowed:
+            bad.append("CPU time")
+    m["verdict"] = "fail" if bad else "pass"
+    if bad:
+        m["why"] = ", ".join(bad) + " beyond the tolerance"
+    return m
 
 
 def _downstream(ctx: Context, origins: set[tuple[str, str | None]]) -> set[tuple[str, str]]:
@@ -109,7 +165,11 @@ def data_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
     hashes = {n: ctx.run.port_hashes(n) for n in ctx.node_names}
     if not any(hashes.values()):
         return {"verdict": "n/a", "why": "the run traced no port hashes"}
-    t_first = min((c.t_ns for c in conf if c.t_ns is not None), default=None)
+    # when the first fault acted: confirmed, else as its injector says, else as requested
+    t_first = min((c.t_ns if c.t_ns is not None else c.applied_t_ns
+                   if c.applied_t_ns is not None else inj.fault.at_ns
+                   for inj, c in zip(ctx.plan.injections, conf, strict=True)), default=None)
+    stopped = set(ctx.plan.kills) | set(ctx.plan.hangs)
     origins = set()
     for inj in ctx.plan.injections:
         origins |= direct_targets(inj) or ({(inj.node, "io")} if inj.node in ctx.node_names
@@ -126,6 +186,8 @@ def data_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
                 limit = 1 << 62
             a = [x for x in run_seq if x[0] < limit]
             b = [x for x in gold.get(key, []) if x[0] < limit]
+            if node in stopped:  # a node killed or frozen loses the trace it had not written
+                b = b[:len(a)]
             compared += len(b)
             if a != b:
                 at = next((x[0] for x, y in zip(a, b, strict=False) if x != y), limit)
@@ -144,7 +206,7 @@ def detection(ctx: Context, conf: list[Confirmation]) -> dict:
     confirmed injection; and every detector that fired at all."""
     per_fault, ok = [], True
     for inj, c in zip(ctx.plan.injections, conf, strict=True):
-        fc = catalogue.get(inj.fault.cls)
+        fc = ctx.fault_class(inj.fault)
         want = fc.detectors(ctx.redundant)
         if c.t_ns is None:
             per_fault.append({"fault": inj.fid, "node": inj.node, "verdict": "n/a",
@@ -194,11 +256,11 @@ def degraded_mode(ctx: Context, conf: list[Confirmation]) -> dict:
     the downlink within the class's bound."""
     per_fault, ok = [], True
     for inj, c in zip(ctx.plan.injections, conf, strict=True):
-        want = catalogue.get(inj.fault.cls).mode
+        want = ctx.fault_class(inj.fault).mode
         if not want or c.t_ns is None:
             continue
         t = detectors.reached_mode(ctx, c.t_ns, want["mode"], want.get("fallback"))
-        bound = catalogue.get(inj.fault.cls).latency_ms
+        bound = float(want.get("within_ms", ctx.fault_class(inj.fault).latency_ms))
         good = t is not None and (t - c.t_ns) / 1e6 <= bound
         ok = ok and good
         per_fault.append({"fault": inj.fid, "expected": want, "bound_ms": bound,
@@ -248,13 +310,13 @@ def envelope(ctx: Context, conf: list[Confirmation]) -> dict:
     found = envelope_findings(ctx)
     left = bool(found["left"]) or found["crashed"]
     limits = [inj.fid for inj in ctx.plan.injections
-              if catalogue.get(inj.fault.cls).known_limit_applies(
+              if ctx.fault_class(inj.fault).known_limit_applies(
                   ctx.redundant, inj.fault.target.node == "*")]
     result = {"left": found["left"], "crashed": found["crashed"], "known_limit": limits}
     verdict = "fail" if left and not limits else "pass"
     if ctx.golden is not None and ctx.redundant and len(ctx.plan.faults) == 1:
         f = ctx.plan.faults[0]
-        masked = catalogue.get(f.cls).masked
+        masked = ctx.fault_class(f).masked
         single = f.target.node not in ("*", "world", "bus")
         identical = ctx.run.truth_bytes == ctx.golden.truth_bytes
         result["truth_identical"] = identical

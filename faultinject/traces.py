@@ -72,6 +72,29 @@ class RunTraces:
                 if e.get("kind") in ("window_start", "window_end")
                 and e.get("partition") == partition]
 
+    def window_lateness(self, node: str, partition: str) -> list[int]:
+        """How long after its wall-clock time each of the partition's windows started (ns;
+        `ima launch --realtime` only: the SKE's `wall_late_ns`)."""
+        return [e["wall_late_ns"] for e in self.node_events.get(node, [])
+                if e.get("kind") == "window_start" and e.get("partition") == partition
+                and "wall_late_ns" in e]
+
+    def stats(self, node: str) -> dict:
+        """The node's SKE statistics (nodeK.json), {} when it wrote none."""
+        try:
+            return json.loads((self.run_dir / f"{node}.json").read_text())
+        except (OSError, ValueError):
+            return {}
+
+    def cpu_ns(self, node: str, partition: str) -> int | None:
+        """The CPU time the partition used, as the SKE measured it on the host."""
+        return next((p.get("cpu_ns") for p in self.stats(node).get("partitions", [])
+                     if p.get("name") == partition), None)
+
+    @property
+    def realtime(self) -> bool:
+        return bool(self.launch.get("realtime"))
+
     def port_hashes(self, node: str) -> dict[tuple[str, str], list[tuple[int, str]]]:
         out: dict[tuple[str, str], list[tuple[int, str]]] = defaultdict(list)
         for e in self.node_kind(node, "port_hash"):

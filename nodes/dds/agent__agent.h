@@ -155,6 +155,7 @@ struct agent {
     /* statistics */
     agent_topic_stats_t ts[T_COUNT];
     uint64_t agreed, waits, timeouts, superseded, bad_datagrams, partial;
+    uint64_t deadline_paused;  /* lockstep: deadline misses while this node was paused too */
     agent_lat_t xch_lat;       /* io's request to its AGREED */
     agent_lat_t dds_lat;       /* a peer's dds_write of its inputs to their take here */
     bool ready;                /* discovery is over: the DDS latency is measured from here on */

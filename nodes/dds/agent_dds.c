@@ -406,6 +406,14 @@ static void handle_deadline(agent_t *a, const agent_ev_t *ev)
     if (k < 1 || k > a->o.nodes || k == a->o.node)
         return;
     agent_peer_t *p = &a->peer[k - 1];
+    /* In lockstep, the deadline (wall time) says something of the peer only while this node
+     * is flying too: when its io has asked for no frame for as long, the whole system is
+     * paused (the bus stopped at the end of the run, or the host stalled), not the peer. */
+    if (!a->o.realtime && !a->pending &&
+        agent_mono_ns() - a->pend_start_ns >= a->o.deadline_ns) {
+        a->deadline_paused++;
+        return;
+    }
     p->deadline_misses += ev->change > 0 ? (uint64_t)ev->change : 1;
     if (p->deadline_missed)
         return; /* one line per episode: until the node publishes its health again */
@@ -558,9 +566,14 @@ static void take_topic(agent_t *a, int t)
                     agent_lat_add(&a->dds_lat, dds_time() - si[i].source_timestamp);
                 struct xch_inputs x;
                 inputs_from_dds(&x, &buf[i].in);
-                if (x.wait_mask & AGREE_LOST_MARK) /* a fault keeps that frame back */
-                    agree_store_lost(&a->agree, k, buf[i].in.frame, buf[i].in.t_ns);
-                else
+                if (x.wait_mask & AGREE_LOST_MARK) { /* a fault keeps that frame back */
+                    if (agree_store_lost(&a->agree, k, buf[i].in.frame, buf[i].in.t_ns) &&
+                        agent_trace_begin_at(a, "xch_peer_missing", buf[i].in.t_ns)) {
+                        fprintf(a->trace, ",\"peer\":\"node%u\",\"frame\":%" PRIu32, k,
+                                buf[i].in.frame);
+                        agent_trace_end(a);
+                    }
+                } else
                     agree_store(&a->agree, k, buf[i].in.frame, buf[i].in.t_ns, &x);
             } else if (t == T_HEALTH) {
                 a->peer[k - 1].deadline_missed = false;

@@ -130,6 +130,9 @@ static int deliver(canbus_bus_t *b, int64_t t, bool tick)
                 c->done = false;
                 b->out[n++] = (struct canbus_rec){.type = CANBUS_MSG_TICK, .t_ns = b->t_next,
                                                   .aux = t};
+                if (b->o.realtime) /* data = the release lateness, ns, little-endian */
+                    for (int j = 0; j < 8; j++)
+                        b->out[n - 1].data[j] = (uint8_t)((uint64_t)b->release_late_ns >> (8 * j));
             }
             for (size_t k = 0; k < n && !c->gone; k += CANBUS_MAX_RECS) {
                 size_t m = n - k < CANBUS_MAX_RECS ? n - k : CANBUS_MAX_RECS;
@@ -224,6 +227,12 @@ int canbus_bus_run(canbus_bus_t *b)
         if (b->o.realtime) {
             for (int64_t now; !b->stopping && (now = canbus__wall_ns()) < b->epoch_wall + b->t;)
                 canbus__service(b, b->epoch_wall + b->t - now);
+            /* How late this quantum goes out (the nodes took longer than the wall clock): the
+             * TICK carries it, so a node can tell how late each of its windows starts. */
+            b->release_late_ns = canbus__wall_ns() - (b->epoch_wall + b->t);
+            if (b->release_late_ns > b->late_max_ns)
+                b->late_max_ns = b->release_late_ns;
+            b->quanta_late += b->release_late_ns > 1000000;
         }
         wait_queues(b);
         if (b->stopping)

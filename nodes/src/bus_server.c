@@ -103,12 +103,13 @@ int canbus_bus_write_stats(canbus_bus_t *b, const char *path)
             ",\"duplicated\":%" PRIu64 ",\"rx_dropped\":%" PRIu64 ",\"rejected\":%" PRIu64 ",\"bad_hellos\":%" PRIu64 ",\"late_joins\":%" PRIu64
             ",\"refused_full\":%" PRIu64 ",\"send_timeouts\":%" PRIu64
             ",\"garbage_disconnects\":%" PRIu64 ",\"faults_armed\":%" PRIu64
-            ",\"wall_s\":%.6f,\"frames_per_wall_s\":%.1f,\"stop\":\"%s\",\"clients\":[",
+            ",\"wall_s\":%.6f,\"frames_per_wall_s\":%.1f,\"release_late_max_us\":%.1f"
+            ",\"quanta_late\":%" PRIu64 ",\"stop\":\"%s\",\"clients\":[",
             b->o.bitrate, b->o.quantum_ns, b->quanta, b->t, w->frames, w->frame_bits,
             w->busy_bits, canbus_wire_bit_ns(w, w->busy_bits), load, max1, w->error_frames,
             w->bus_off_events, w->dropped, w->duplicated, w->rx_dropped, b->rejected, b->bad_hellos, b->late_joins, b->full,
             b->send_timeouts, b->garbage_kicks, b->faults_armed + b->o.n_faults, wall,
-            wall > 0 ? (double)w->frames / wall : 0.0,
+            wall > 0 ? (double)w->frames / wall : 0.0, (double)b->late_max_ns / 1e3, b->quanta_late,
             canbus__stop_name(b->stop_reason));
     for (int i = 0; i < b->next_index; i++) {
         const canbus_client_t *c = b->by_index[i];

@@ -107,6 +107,9 @@ typedef struct canbus_bus {
     int64_t t;      /* start of the current quantum */
     int64_t t_next; /* end of the current quantum (the TICK's t_ns) */
     int64_t epoch_wall;
+    int64_t release_late_ns;   /* realtime: how late the current quantum was released */
+    int64_t late_max_ns;       /* realtime: the latest release */
+    uint64_t quanta_late;      /* realtime: quanta released more than 1 ms late */
     int64_t start_wall, end_wall;
     bool stopping;
     uint32_t stop_reason;

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/socket.h>
 #include <sys/un.h>
+#include <time.h>
 #include <unistd.h>
 
 static int send_all(int fd, const void *buf, size_t len)
@@ -69,6 +70,16 @@ static int read_datagram(canbus_client_t *c, bool block)
             if (r->t_ns > c->granted_ns)
                 c->granted_ns = r->t_ns;
             c->ticked = true;
+            if (c->flags & CANBUS_WELCOME_REALTIME) {
+                uint64_t late = 0;
+                for (int b = 0; b < 8; b++)
+                    late |= (uint64_t)r->data[b] << (8 * b);
+                struct timespec ts;
+                clock_gettime(CLOCK_MONOTONIC, &ts);
+                c->tick_mono_ns = (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+                c->tick_late_ns = (int64_t)late;
+                c->tick_start_ns = r->aux;
+            }
             break;
         case CANBUS_MSG_STOP:
             c->stopped = true;

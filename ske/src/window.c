@@ -305,6 +305,14 @@ int ske__run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen)
         ske_trace_str(&s->trace, "partition_state", ske__pstate_name(p->state));
     if (rt || late > 0)
         ske_trace_int(&s->trace, "late_ns", late);
+    if (!rt && (s->bus.flags & CANBUS_WELCOME_REALTIME) && s->bus.ticked) {
+        /* Lockstep on a bus paced by the wall clock: how long after its wall-clock time this
+         * window starts (0 when the node is ahead of the clock, as it runs each quantum's
+         * windows as soon as the bus grants it). */
+        int64_t wl = ske_mono_ns() - s->bus.tick_mono_ns + s->bus.tick_late_ns -
+                     (start - s->bus.tick_start_ns);
+        ske_trace_int(&s->trace, "wall_late_ns", wl > 0 ? wl : 0);
+    }
     ske_trace_end(&s->trace);
     ske__faults_window_start(s, p, start);
 

@@ -32,6 +32,10 @@ typedef struct {
     bool ticked;         /* LOCKSTEP: a first TICK has come */
     bool waiting;        /* LOCKSTEP: DONE sent, TICK not yet come */
     int64_t wait_from_ns;
+    /* LOCKSTEP on a realtime bus: the latest TICK's quantum start, how late the bus released
+     * it, and when it came (CLOCK_MONOTONIC): a window at emulated s starts
+     * now - tick_mono_ns + tick_late_ns - (s - tick_start_ns) after its wall-clock time. */
+    int64_t tick_start_ns, tick_late_ns, tick_mono_ns;
     uint64_t overflowed; /* frames dropped because nobody took them (queue full) */
     /* frames received but not yet taken by canbus_client_recv(): a ring */
     struct canbus_rec in[CANBUS_IN_RECS];

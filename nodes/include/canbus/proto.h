@@ -83,7 +83,9 @@ struct canbus_welcome {
 
 enum canbus_rec_type {
     CANBUS_MSG_FRAME = 1, /* a CAN data frame, either way */
-    CANBUS_MSG_TICK = 2,  /* bus -> LOCKSTEP client: advance to t_ns; aux = start of the quantum */
+    CANBUS_MSG_TICK = 2,  /* bus -> LOCKSTEP client: advance to t_ns; aux = start of the quantum;
+                             a --realtime bus: data = how late it released the quantum on its
+                             wall clock (int64 ns, little-endian), else zeros */
     CANBUS_MSG_DONE = 3,  /* LOCKSTEP client -> bus: finished everything before t_ns */
     CANBUS_MSG_STOP = 4,  /* either way: the run ends; id = CANBUS_STOP_* reason */
     CANBUS_MSG_ERROR = 5, /* bus -> CAN clients: an error frame on the wire (id = the frame's

@@ -46,6 +46,7 @@ class RunSpec:
     workload: str
     seed: int
     weight: float = 1.0
+    realtime: bool = False  # flown with --realtime (and so is its golden run)
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -129,6 +130,24 @@ def targets_of(system, cls: str) -> list[str]:
     return out
 
 
+def _systems(c: Campaign) -> dict:
+    """The system each workload flies: the campaign's, or the one derived from it with the
+    mission feed (built in a scratch folder here, to check the faults' targets against)."""
+    import tempfile
+
+    from ima.deploy import load_system
+
+    from . import systems as derived
+
+    base = load_system(c.system)
+    out = {}
+    with tempfile.TemporaryDirectory(prefix="ima-campaign-") as tmp:
+        for name, w in c.workloads.items():
+            out[name] = base if not w.mission_feed else load_system(
+                derived.with_mission_feed(c.system, Path(tmp) / f"{name}.yaml", w.mission_feed))
+    return out
+
+
 def _slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9]+", "-", text).strip("-").lower()
 
@@ -144,9 +163,8 @@ def expand(c: Campaign) -> list[RunSpec]:
     """The campaign's runs, in a fixed order; every fault spec checked (grammar, catalogue,
     the system's targets)."""
     from faultinject.plan import check_target
-    from ima.deploy import load_system
 
-    system = load_system(c.system)
+    systems = _systems(c)
     runs: list[RunSpec] = []
     for i, entry in enumerate(c.doc["faults"]):
         where = f"{c.path}: faults[{i}]"
@@ -157,6 +175,7 @@ def expand(c: Campaign) -> list[RunSpec]:
                 raise CampaignError(f"{where}: no workload '{w}' (workloads: "
                                     f"{', '.join(c.workloads)})")
         weight = float(entry.get("weight", 1.0))
+        realtime = bool(entry.get("realtime", False))
         if "specs" in entry:
             groups = [(entry["name"], tuple(entry["specs"]))]
             classes = None
@@ -167,7 +186,7 @@ def expand(c: Campaign) -> list[RunSpec]:
             except ImaError as exc:
                 raise CampaignError(f"{where}: {exc}") from None
             sel = entry.get("targets", "all")
-            pool = targets_of(system, cls)
+            pool = targets_of(systems[loads[0]], cls)
             if sel == "all":
                 wheres = pool
             elif isinstance(sel, dict):
@@ -188,7 +207,8 @@ def expand(c: Campaign) -> list[RunSpec]:
                 faults = [grammar.parse(s, f"f{k}") for k, s in enumerate(specs, start=1)]
                 grammar.check_ids(faults, where)
                 for f in faults:
-                    check_target(system, f)
+                    for w in loads:
+                        check_target(systems[w], f)
                     if f.trigger.at_s is not None and not f.trigger.at_s < c.duration_s:
                         raise CampaignError(f"{where}: {f.spec()}: after the end of the flights "
                                             f"({c.duration_s:g} s)")
@@ -200,16 +220,18 @@ def expand(c: Campaign) -> list[RunSpec]:
                         n = len(runs) + 1
                         tag = _slug(specs[0].split(":")[0]) if classes else group
                         run_id = f"{n:04d}-{classes or group}-{tag}-{w}-s{seed}" + \
+                            ("-rt" if realtime else "") + \
                             (f"-r{rep + 1}" if c.repetitions > 1 else "")
                         runs.append(RunSpec(run_id, classes or group,
                                             tuple(f.cls for f in faults), tuple(specs), w, seed,
-                                            weight))
+                                            weight, realtime))
     if not runs:
         raise CampaignError(f"{c.path}: no runs")
     return runs
 
 
 def golden_key(c: Campaign, run: RunSpec) -> str:
-    """Runs share a golden run when they share system, workload and seed (and duration)."""
-    return f"{run.workload}-s{run.seed}"
+    """Runs share a golden run when they share system, workload, seed and time mode (and
+    duration)."""
+    return f"{run.workload}-s{run.seed}" + ("-rt" if run.realtime else "")
 

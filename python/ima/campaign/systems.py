@@ -49,7 +49,8 @@ def with_mission_feed(system: Path, dest: Path, feed: dict) -> Path:
                            [FEED_WINDOW])
     doc["channels"] = dict(doc["channels"], intra_node=list(doc["channels"]["intra_node"]) + [
         {"name": "mission", "from": "mission_feed.MISSION_OUT", "to": "nav_fcs.MISSION_IN"},
-        {"name": "feed_log", "from": "mission_feed.FEED_LOG_OUT", "to": "mission_feed.FEED_LOG_IN"}])
+        {"name": "feed_log", "from": "mission_feed.FEED_LOG_OUT",
+         "to": "mission_feed.FEED_LOG_IN"}])
     dest.parent.mkdir(parents=True, exist_ok=True)
     header = (f"# Generated from {system} with the stand-in mission feed — do not edit.\n"
               "# SPDX-License-Identifier: Apache-2.0\n")

@@ -29,10 +29,11 @@ EVIDENCE = ("hm", "overrun", "port_silent", "port_changed", "frames_stopped", "f
             "module_reset", "app_report")
 ASKED_MODES = ("DIRECT", "AUTOPILOT", "MISSION")
 # What a case may change: the expectations that depend on where and when the fault acts.
-CASE_KEYS = ("evidence", "detect", "latency_ms", "mode", "masked", "outcomes")
-# What a case's `when` may name: the mode the pilot asks for at the injection, the target
-# partition, and whether the fault is common-mode (every node at once).
-WHEN_KEYS = ("asked", "partition", "common_mode")
+CASE_KEYS = ("evidence", "detect", "latency_ms", "mode", "masked", "outcomes", "known_limit")
+# What a case's `when` may name: the mode the pilot asks for at the injection, the mode the
+# flight control flies then, the target partition and port, and whether the fault is
+# common-mode (every node at once).
+WHEN_KEYS = ("asked", "flown", "partition", "port", "common_mode")
 PARAM_TYPES = ("number", "int", "time", "name", "choice")
 
 
@@ -64,13 +65,12 @@ class FaultClass:
     # (when, this class with the case's expectations): the first case that holds decides
     cases: tuple[tuple[dict, FaultClass], ...] = ()
 
-    def case(self, asked: str | None, partition: str | None, common_mode: bool) -> FaultClass:
+    def case(self, **facts) -> FaultClass:
         """The class's expectations for a fault of it: those of the first of the catalogue's
-        `cases` whose `when` holds (the mode the pilot asks for at the injection, the target
-        partition, common mode), or the class's own."""
-        facts = {"asked": asked, "partition": partition, "common_mode": common_mode}
+        `cases` whose `when` holds of the facts (WHEN_KEYS: asked, flown, partition, port,
+        common_mode), or the class's own."""
         for when, fc in self.cases:
-            if all(facts[k] == v for k, v in when.items()):
+            if all(facts.get(k) == v for k, v in when.items()):
                 return fc
         return self
 
@@ -82,6 +82,19 @@ class FaultClass:
 
     def expected_outcomes(self, redundant: bool) -> tuple[str, ...]:
         return self.outcomes[self.variant(redundant)]
+
+    def known_limits(self) -> list[str]:
+        """Every known limit the catalogue declares for the class, its own and its cases',
+        each said with where it applies."""
+        out = []
+        if self.known_limit:
+            out.append(f"{self.known_limit['applies']}: {self.known_limit['reason']}")
+        for when, fc in self.cases:
+            if fc.known_limit and fc.known_limit != self.known_limit:
+                cond = ", ".join(k.replace("_", " ") if v is True else f"{k}={v}"
+                                 for k, v in when.items())
+                out.append(f"{cond}: {fc.known_limit['reason']}")
+        return out
 
     def known_limit_applies(self, redundant: bool, common_mode: bool) -> bool:
         if not self.known_limit:
@@ -154,8 +167,9 @@ def _load_class(name: str, c: dict) -> FaultClass:
         when = (case or {}).get("when")
         if not isinstance(when, dict) or not when or set(when) - set(WHEN_KEYS):
             raise _fail(at, f"needs `when` with any of {', '.join(WHEN_KEYS)}")
-        if "asked" in when:
-            _choice(f"{at}.when.asked", when["asked"], ASKED_MODES)
+        for key in ("asked", "flown"):
+            if key in when:
+                _choice(f"{at}.when.{key}", when[key], ASKED_MODES)
         bad = set(case) - set(CASE_KEYS) - {"when"}
         if bad:
             raise _fail(at, f"a case may change only {', '.join(CASE_KEYS)}, not {sorted(bad)}")

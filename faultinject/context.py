@@ -28,24 +28,33 @@ class Context:
     def node_names(self) -> list[str]:
         return [n.name for n in self.system.nodes]
 
-    def asked_mode(self, t_ns: int | None) -> str | None:
-        """The mode the pilot asks for at t_ns, from the golden run's FCS heartbeats (the
-        run's when there is none): DIRECT, AUTOPILOT, MISSION, or None before any."""
-        if t_ns is None:
-            return None
-        names = fcs_choices("FCS_REQ_MODE")
-        asked = None
-        for t, _k, d in (self.golden or self.run).fcs_status:
+    def _mode_at(self, traces: RunTraces, field: str, t_ns: int) -> str | None:
+        names = fcs_choices(field)
+        value = None
+        for t, _k, d in traces.fcs_status:
             if t > t_ns:
                 break
-            asked = names.get(d.get("FCS_REQ_MODE"))
-        return asked
+            value = names.get(d.get(field))
+        return value
+
+    def asked_mode(self, t_ns: int) -> str | None:
+        """The mode the pilot asks for at t_ns, from the golden run's FCS heartbeats (the
+        run's when there is none): DIRECT, AUTOPILOT, MISSION, or None before any."""
+        return self._mode_at(self.golden or self.run, "FCS_REQ_MODE", t_ns)
+
+    def flown_mode(self, t_ns: int) -> str | None:
+        """The mode the flight control flies at t_ns in this run (an earlier fault of the run
+        may have changed it): its last heartbeat at or before t_ns."""
+        return self._mode_at(self.run, "FCS_MODE", t_ns)
 
     def fault_class(self, fault) -> catalogue.FaultClass:
         """The catalogue's class of a fault, with the expectations of its case (the mode asked
-        at the injection, the target partition, common mode)."""
+        and flown at the injection, the target partition and port, common mode)."""
         fc = catalogue.get(fault.cls)
         if not fc.cases:
             return fc
-        asked = None if fault.trigger.at_s is None else self.asked_mode(fault.at_ns)
-        return fc.case(asked, fault.target.partition, fault.target.node == "*")
+        at = None if fault.trigger.at_s is None else fault.at_ns
+        return fc.case(asked=None if at is None else self.asked_mode(at),
+                       flown=None if at is None else self.flown_mode(at),
+                       partition=fault.target.partition, port=fault.target.port,
+                       common_mode=fault.target.node == "*")

@@ -6,6 +6,8 @@ handling. Each gives the first time it fired at or after an instant, for a targe
 
 from __future__ import annotations
 
+import bisect
+
 from faultinject.context import Context
 from faultinject.plan import Injection
 from faultinject.traces import fcs_choices
@@ -72,8 +74,23 @@ def dds_deadline(ctx: Context, inj: Injection, t0: int) -> int | None:
 
 
 def _status_change(ctx: Context, t0: int, field: str, changed) -> int | None:
-    """The first heartbeat at or after t0 whose `field` changed (changed(before, now)) from the
-    same replica's value before t0."""
+    """The first heartbeat at or after t0 whose `field` changed (changed(expected, now)) from
+    what the same replica reported in the golden run at that time (the workload's own mode
+    changes are no detection); without a golden run, from its value before t0."""
+    if ctx.golden is not None:
+        gold: dict[int, tuple[list[int], list]] = {}
+        for t, k, d in ctx.golden.fcs_status:
+            times, values = gold.setdefault(k, ([], []))
+            times.append(t)
+            values.append(d.get(field))
+        for t, k, d in ctx.run.fcs_status:
+            if t < t0 or k not in gold:
+                continue
+            times, values = gold[k]
+            i = bisect.bisect_right(times, t) - 1
+            if i >= 0 and changed(values[i], d.get(field)):
+                return t
+        return None
     before: dict[int, int] = {}
     for t, k, d in ctx.run.fcs_status:
         v = d.get(field)

@@ -99,7 +99,7 @@ def render(report: dict, records: list[dict]) -> str:
                       "coverage", "95 % CI", "latency ms median / p95 / max", "violations"],
                      rows)
     limits = _table(["class", "known limit (declared in the catalogue)"],
-                    [[c, why] for c, why in report["known_limits"].items()])
+                    [[c, why] for c, whys in report["known_limits"].items() for why in whys])
     failing = [[r["run_id"], ", ".join(r["fault"]["specs"]), r["measures"]["outcome"],
                 ", ".join(r["measures"]["oracle_violations"]) or "-", r.get("run_dir") or "-"]
                for r in records if r["measures"]["oracle_violations"]

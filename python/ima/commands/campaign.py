@@ -151,6 +151,9 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(rep))
     else:
-        report.print_summary(rep, Console())
-        Console().print("Report: " + ", ".join(str(p) for p in written))
+        term = Console()
+        if not term.is_terminal:  # a log file: wide enough for the table on one line a class
+            term = Console(width=140)
+        report.print_summary(rep, term)
+        term.print("Report: " + ", ".join(str(p) for p in written))
     return 0

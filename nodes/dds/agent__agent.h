@@ -69,6 +69,8 @@ typedef struct {
     bool dead;           /* latched */
     bool deadline_missed;/* a NodeHealth deadline miss traced, no sample since */
     int64_t last_rx_ns;  /* CLOCK_MONOTONIC of its latest sample taken, any topic */
+    bool health_seen;    /* a NodeHealth of it has come */
+    uint32_t health_own_frame; /* this node's latest frame when it came */
     int64_t lost_wall_ns;
     uint64_t deadline_misses;
 } agent_peer_t;
@@ -145,6 +147,7 @@ struct agent {
     int64_t pend_start_ns;     /* CLOCK_MONOTONIC of the request */
     bool pend_waited;
     int64_t last_t_ns;         /* emulated time of the latest request (for the trace) */
+    bool have_frame;           /* io has asked for a frame: pend_frame is its latest */
 
     /* faults (agent_fault.c): this node's publications they keep back */
     dds_faults_t faults;

@@ -406,11 +406,12 @@ static void handle_deadline(agent_t *a, const agent_ev_t *ev)
     if (k < 1 || k > a->o.nodes || k == a->o.node)
         return;
     agent_peer_t *p = &a->peer[k - 1];
-    /* In lockstep, the deadline (wall time) says something of the peer only while this node
-     * is flying too: when its io has asked for no frame for as long, the whole system is
-     * paused (the bus stopped at the end of the run, or the host stalled), not the peer. */
-    if (!a->o.realtime && !a->pending &&
-        agent_mono_ns() - a->pend_start_ns >= a->o.deadline_ns) {
+    /* In lockstep, the deadline (wall time) says something of the peer only if this node
+     * flew on meanwhile: unless its io has asked for two frames or more since the peer's last
+     * health, the whole system is paused (the bus stopped at the end of the run, the host
+     * stalled), not the peer. */
+    if (!a->o.realtime && (!a->have_frame || !p->health_seen ||
+                           (int32_t)(a->pend_frame - p->health_own_frame) < 2)) {
         a->deadline_paused++;
         return;
     }
@@ -577,6 +578,8 @@ static void take_topic(agent_t *a, int t)
                     agree_store(&a->agree, k, buf[i].in.frame, buf[i].in.t_ns, &x);
             } else if (t == T_HEALTH) {
                 a->peer[k - 1].deadline_missed = false;
+                a->peer[k - 1].health_seen = true;
+                a->peer[k - 1].health_own_frame = a->pend_frame;
             }
         }
     }

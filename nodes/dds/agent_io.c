@@ -188,6 +188,7 @@ static void on_inputs(agent_t *a, const struct xch_hdr *h, const struct xch_inpu
     agree_store(&a->agree, a->o.node, h->frame, h->t_ns, in);
     agent_fault_publish(a, T_INPUTS, h, in);
     a->pending = true;
+    a->have_frame = true;
     a->pend_frame = h->frame;
     a->pend_mask = in->wait_mask;
     a->pend_t_ns = h->t_ns;

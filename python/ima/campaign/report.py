@@ -107,7 +107,9 @@ def print_summary(report: dict, console) -> None:
     if ov["coverage"] is not None:
         console.print(f"Overall (stratified): coverage {ov['coverage']:.3f}, 95% interval "
                       f"[{ov['ci95'][0]:.3f}, {ov['ci95'][1]:.3f}] over {ov['classes']} classes")
-    console.print("* some of its runs met a known limit of the design, declared in the catalogue")
+    if any(r.get("known_limit") for r in report["classes"]):
+        console.print("* some of its runs met a known limit of the design, declared in the "
+                      "catalogue")
     bad = report["oracle_violations"]
     console.print(f"Oracle violations: {len(bad)}" + (f" ({', '.join(v['run_id'] for v in bad[:5])}"
                                                        f"{' ...' if len(bad) > 5 else ''})"

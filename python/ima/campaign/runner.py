@@ -17,6 +17,8 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 
+import yaml
+
 from ima.campaign import job, spec, systems
 from ima.errors import ImaError
 
@@ -46,6 +48,18 @@ def campaign_data(c: spec.Campaign, opts: RunnerOptions) -> dict:
                       for w in c.workloads.values()},
         "golden_of": {r.run_id: spec.golden_key(c, r) for r in c.runs},
     }
+
+
+def drop_cut_line(out: Path) -> None:
+    """A results.jsonl whose last line a crash cut short loses that line (its run is flown
+    again), so that the next record starts a line of its own."""
+    path = out / RESULTS
+    try:
+        data = path.read_bytes()
+    except OSError:
+        return
+    if data and not data.endswith(b"\n"):
+        path.write_bytes(data[:data.rfind(b"\n") + 1])
 
 
 def done_ids(out: Path) -> set[str]:
@@ -145,7 +159,10 @@ class _Dask:
     def wait(self, futures):
         from distributed import wait as dwait
 
-        done, _ = dwait(list(futures), timeout=0.5, return_when="FIRST_COMPLETED")
+        try:
+            done, _ = dwait(list(futures), timeout=0.5, return_when="FIRST_COMPLETED")
+        except TimeoutError:  # distributed's wait raises when nothing finished in time
+            return set()
         return done
 
     def close(self, cancel: bool = False) -> None:
@@ -165,9 +182,20 @@ def prepare(c: spec.Campaign, opts: RunnerOptions) -> dict:
     if (out / RESULTS).exists() and not opts.resume:
         raise ImaError(f"{out} already holds a campaign's results: --resume to go on with it, "
                        "or another --out", exit_code=2)
+    if opts.resume and (out / "campaign.json").is_file():
+        try:
+            before = json.loads((out / "campaign.json").read_text())["runs"]
+        except (OSError, ValueError, KeyError):
+            before = None
+        if before is not None and before != [r.to_json() for r in c.runs]:
+            raise ImaError(f"{out}: planned with another version of {c.path.name}: its runs "
+                           "differ; resume with the campaign as it was, or use another --out",
+                           exit_code=2)
     out.mkdir(parents=True, exist_ok=True)
     (out / "runs").mkdir(exist_ok=True)
-    shutil.copy2(c.path, out / "campaign.yaml")
+    (out / "campaign.yaml").write_text(
+        f"# {c.path}, as this campaign ran it (its paths made absolute)\n" +
+        yaml.safe_dump(spec.resolved_doc(c), sort_keys=False), encoding="utf-8")
     data = campaign_data(c, opts)
     for w in c.workloads.values():
         if w.mission_feed:
@@ -182,6 +210,8 @@ def prepare(c: spec.Campaign, opts: RunnerOptions) -> dict:
 def run(c: spec.Campaign, opts: RunnerOptions, progress=None) -> list[dict]:
     """Every run of the campaign not yet done; returns every record of results.jsonl."""
     data = prepare(c, opts)
+    if opts.resume:
+        drop_cut_line(opts.out)
     done = done_ids(opts.out) if opts.resume else set()
     todo = [r for r in c.runs if r.run_id not in done]
     goldens = {}

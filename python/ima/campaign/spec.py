@@ -230,6 +230,15 @@ def expand(c: Campaign) -> list[RunSpec]:
     return runs
 
 
+def resolved_doc(c: Campaign) -> dict:
+    """The campaign file's content with its paths made absolute: the copy a campaign folder
+    keeps (campaign.yaml), which `--resume` and `rerun` load wherever the folder is."""
+    doc = dict(c.doc, system=str(c.system))
+    doc["workloads"] = {name: dict(w, pilot=str(c.workloads[name].pilot))
+                        for name, w in c.doc["workloads"].items()}
+    return doc
+
+
 def golden_key(c: Campaign, run: RunSpec) -> str:
     """Runs share a golden run when they share system, workload, seed and time mode (and
     duration)."""

@@ -203,7 +203,8 @@ def data_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
 
 def detection(ctx: Context, conf: list[Confirmation]) -> dict:
     """Per fault: the detectors the catalogue expects fired, within its latency bound from the
-    confirmed injection; and every detector that fired at all."""
+    confirmed injection, and the target node's health monitor recorded the class's error
+    (`hm_error`) within it; and every detector that fired at all."""
     per_fault, ok = [], True
     for inj, c in zip(ctx.plan.injections, conf, strict=True):
         fc = ctx.fault_class(inj.fault)
@@ -219,13 +220,28 @@ def detection(ctx: Context, conf: list[Confirmation]) -> dict:
         else:
             good = [k for k in want if k in latency and latency[k] <= fc.latency_ms]
             verdict = "pass" if good else "fail"
-        ok = ok and verdict != "fail"
         first = min(latency.values()) if latency else None
-        per_fault.append({"fault": inj.fid, "node": inj.node, "verdict": verdict,
-                          "expected": list(want), "bound_ms": fc.latency_ms,
-                          "fired_ms": {k: round(v, 3) for k, v in latency.items()},
-                          "latency_ms": None if first is None else round(first, 3)})
+        entry = {"fault": inj.fid, "node": inj.node, "expected": list(want),
+                 "bound_ms": fc.latency_ms,
+                 "fired_ms": {k: round(v, 3) for k, v in latency.items()},
+                 "latency_ms": None if first is None else round(first, 3)}
+        if fc.hm_error and inj.node in ctx.node_names and {"hm", "self_monitor"} & set(want):
+            # the health monitor of the target's node records the error the class is
+            t_err = _hm_error_at(ctx, inj, c.t_ns, fc.hm_error)
+            entry["hm_error"] = {"expected": fc.hm_error, "ms": None if t_err is None
+                                 else round((t_err - c.t_ns) / 1e6, 3)}
+            if t_err is None or (t_err - c.t_ns) / 1e6 > fc.latency_ms:
+                verdict = "fail"
+        ok = ok and verdict != "fail"
+        per_fault.append(dict(entry, verdict=verdict))
     return {"verdict": "pass" if ok else "fail", "faults": per_fault}
+
+
+def _hm_error_at(ctx: Context, inj: Injection, t0: int, error: str) -> int | None:
+    part = inj.fault.target.partition
+    return next((e["t_ns"] for e in ctx.run.node_kind(inj.node, "hm")
+                 if e["t_ns"] >= t0 and e.get("error") == error
+                 and (part is None or e.get("partition") == part)), None)
 
 
 def hm_action(ctx: Context, conf: list[Confirmation]) -> dict:

@@ -406,12 +406,13 @@ static void handle_deadline(agent_t *a, const agent_ev_t *ev)
     if (k < 1 || k > a->o.nodes || k == a->o.node)
         return;
     agent_peer_t *p = &a->peer[k - 1];
-    /* In lockstep, the deadline (wall time) says something of the peer only if this node
-     * flew on meanwhile: unless its io has asked for two frames or more since the peer's last
-     * health, the whole system is paused (the bus stopped at the end of the run, the host
-     * stalled), not the peer. */
-    if (!a->o.realtime && (!a->have_frame || !p->health_seen ||
-                           (int32_t)(a->pend_frame - p->health_own_frame) < 2)) {
+    /* In lockstep, the deadline (wall time) says something of the peer only while this node
+     * flies: when its io waits for a frame's agreement, or has asked for two frames or more
+     * since the peer's last health. Otherwise the whole system is paused (the bus stopped at
+     * the end of the run, the host stalled), not the peer. */
+    if (!a->o.realtime && !a->pending &&
+        (!a->have_frame || !p->health_seen ||
+         (int32_t)(a->pend_frame - p->health_own_frame) < 2)) {
         a->deadline_paused++;
         return;
     }

@@ -127,6 +127,28 @@ def test_the_catalogue_has_thirty_classes_across_every_layer() -> None:
         assert c.detect["redundant"] and c.outcomes["redundant"], c.name
         if c.known_limit:
             assert c.known_limit["reason"], c.name
-        # no fault confined to one replica may be a known limit of a redundant system
+        # no fault confined to one replica may be a known limit of a redundant system: a
+        # partition or node class declares one that always applies only for common mode
         if c.layer in ("partition", "node") and c.known_limit:
             assert c.known_limit["applies"] != "always", c.name
+        for when, case in c.cases:
+            if c.layer in ("partition", "node") and case.known_limit and \
+                    case.known_limit["applies"] == "always":
+                assert when.get("common_mode") is True, (c.name, when)
+
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_every_class_is_documented_and_in_both_shipped_campaigns() -> None:
+    import yaml
+
+    doc = (ROOT / "docs" / "fault-injection.md").read_text()
+    rows = {line.split("`")[1] for line in doc.splitlines() if line.startswith("| `")}
+    classes = set(catalogue.load())
+    assert classes <= rows, sorted(classes - rows)
+    assert f"one of the catalogue's {len(classes)} classes" in doc
+    for name in ("smoke", "full"):
+        camp = yaml.safe_load((ROOT / "config" / "campaigns" / f"{name}.yaml").read_text())
+        used = {e["class"] for e in camp["faults"] if "class" in e}
+        assert classes <= used, (name, sorted(classes - used))

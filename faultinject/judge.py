@@ -118,10 +118,28 @@ def confirmation(ctx: Context, conf: list[Confirmation]) -> dict:
     return {"verdict": "unconfirmed" if allowed else "fail", "unconfirmed": text}
 
 
+_GOLDEN: dict = {}  # the last golden run read by this process: a campaign's runs share them
+
+
+def golden_traces(golden_dir: Path) -> RunTraces:
+    """The golden run's records, kept from one judgement to the next of the same process
+    (re-read if the run directory was flown again)."""
+    path = Path(golden_dir).resolve()
+    try:
+        stamp = (path / "truth.jsonl").stat().st_mtime_ns
+    except OSError:
+        stamp = None
+    key = (path, stamp)
+    if key not in _GOLDEN:
+        _GOLDEN.clear()
+        _GOLDEN[key] = RunTraces(path)
+    return _GOLDEN[key]
+
+
 def judge(run_dir: Path, golden_dir: Path | None, plan: Plan, system, duration_s: float) -> dict:
     """The `faults`, `oracles` and `outcome` of a run's summary."""
-    ctx = Context(run=RunTraces(run_dir), golden=RunTraces(golden_dir) if golden_dir else None,
-                  plan=plan, system=system, duration_s=duration_s)
+    ctx = Context(run=RunTraces(run_dir), golden=golden_traces(golden_dir) if golden_dir
+                  else None, plan=plan, system=system, duration_s=duration_s)
     conf = [check(ctx, inj) for inj in plan.injections]
     verdicts = {"confirmation": confirmation(ctx, conf)}
     verdicts.update({name: fn(ctx, conf) for name, fn in ORACLES.items()})

@@ -26,6 +26,8 @@ static void usage(FILE *f)
           "  --max-clients N          connected clients at most (64)\n"
           "  --fault SPEC             CLASS:fid=ID,at=TIME[,until=TIME][,period=TIME,on=TIME][,KEY=VALUE]\n"
           "                           (faultinject/README.md; older KIND:KEY=VALUE too); repeatable\n"
+"  --fault-records          accept FAULT records from clients (tests of the record form; off:\n"
+          "                           a client of the public socket cannot arm a fault)\n"
 "  --kill-node N@SECONDS    kill every client of node N (hello.node) at that time; repeatable\n"
           "  --hang-node N@SECONDS    freeze them instead (SIGSTOP): a hung processor; repeatable\n"
           "  --client-order A,B,...   client indices by name (deterministic for racy joins)\n"
@@ -71,7 +73,7 @@ int main(int argc, char **argv)
     enum {
         O_SOCKET = 256, O_BITRATE, O_QUANTUM, O_LOCKSTEP, O_DURATION, O_END, O_REALTIME,
         O_TRACE, O_STATS, O_MAXCL, O_FAULT, O_RECOVER, O_MAXREJ, O_SENDTO, O_CLBUF, O_GAP, O_KILL,
-        O_HANG, O_ORDER,
+        O_HANG, O_ORDER, O_FAULTREC,
         O_HELP
     };
     static const struct option longopts[] = {
@@ -86,6 +88,7 @@ int main(int argc, char **argv)
         {"stats", required_argument, NULL, O_STATS},
         {"max-clients", required_argument, NULL, O_MAXCL},
         {"fault", required_argument, NULL, O_FAULT},
+        {"fault-records", no_argument, NULL, O_FAULTREC},
         {"kill-node", required_argument, NULL, O_KILL},
         {"hang-node", required_argument, NULL, O_HANG},
         {"client-order", required_argument, NULL, O_ORDER},
@@ -143,6 +146,7 @@ int main(int argc, char **argv)
                 bad = "--end-ns must be >= 0";
             break;
         case O_REALTIME: o.realtime = true; break;
+        case O_FAULTREC: o.fault_records = true; break;
         case O_TRACE: o.trace_path = optarg; break;
         case O_STATS: o.stats_path = optarg; break;
         case O_MAXCL:

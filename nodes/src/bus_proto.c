@@ -159,6 +159,10 @@ void canbus__handle_hello(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p,
 static void handle_fault(canbus_bus_t *b, canbus_client_t *c, const struct canbus_rec *r)
 {
     canbus_fault_t f;
+    if (!b->o.fault_records) { /* faults come from the launcher's command line, not clients */
+        canbus__reject(b, c, "fault_records_off");
+        return;
+    }
     if (canbus_fault_from_rec(r, &f)) {
         canbus__reject(b, c, "bad_fault");
         return;

@@ -54,6 +54,7 @@ typedef struct canbus_opts {
     int lockstep_clients;
     int64_t end_ns; /* -1: none */
     bool realtime;
+    bool fault_records; /* --fault-records: clients may arm faults with FAULT records */
     const char *trace_path;
     const char *stats_path;
     int max_clients;

@@ -169,7 +169,7 @@ static int scenario_main(const char *dir, const char *trace_path)
     snprintf(stats_path, sizeof stats_path, "%s/stats.json", dir);
     char *argv[] = {(char *)bus_path, "--socket", sock, "--lockstep-clients", "2",
                     "--quantum-us", "1000", "--end-ns", "8000000", "--trace",
-                    (char *)trace_path, "--stats", stats_path, "-q", NULL};
+                    (char *)trace_path, "--stats", stats_path, "-q", "--fault-records", NULL};
     pid_t pid = start_bus(argv, sock);
     client_t p, a, b, g;
     struct canbus_rec got[64], tick;
@@ -387,17 +387,22 @@ static int scenario_main(const char *dir, const char *trace_path)
 /* A CLI fault corrupts one client's frames until it is bus-off. */
 static int scenario_bus_off(const char *dir)
 {
-    char sock[256];
+    char sock[256], trace[256];
     snprintf(sock, sizeof sock, "%s/bus2.sock", dir);
+    snprintf(trace, sizeof trace, "%s/trace2.jsonl", dir);
     char *argv[] = {(char *)bus_path, "--socket", sock, "--lockstep-clients", "1",
                     "--quantum-us", "1000", "--end-ns", "8000000", "--fault",
-                    "corrupt:client=n1,id=0x123", "-q", NULL};
+                    "corrupt:client=n1,id=0x123", "--trace", trace, "-q", NULL};
     pid_t pid = start_bus(argv, sock);
     client_t obs, n1;
     static struct canbus_rec got[256];
     struct canbus_rec tick;
     int n;
     REQUIRE(join(&obs, sock, "obs", CANBUS_ROLE_CAN) == 0);
+    /* Without --fault-records a client cannot arm a fault: this one would drop every frame. */
+    struct canbus_rec arm = {.type = CANBUS_MSG_FAULT, .flags = 1 /* drop */, .id = 0xFFFFFFFF,
+                             .t_ns = 0, .aux = 0, .data = {0xFF, 0, 0}};
+    sendrecs(&obs, &arm, 1);
     REQUIRE(join(&n1, sock, "n1", CANBUS_ROLE_CAN | CANBUS_ROLE_LOCKSTEP) == 0);
     REQUIRE(until_tick(&n1, got, 256, &n, &tick) == 0);
     struct canbus_rec q0[] = {frame(0x123, 0, 8, 0), frame(0x124, 0, 8, 0), done(1000000)};
@@ -443,6 +448,10 @@ static int scenario_bus_off(const char *dir)
     close(obs.fd);
     close(n1.fd);
     CHECK_EQ(wait_bus(pid), 0);
+    static char text[1 << 16];
+    REQUIRE(read_file(trace, text, sizeof text) > 0);
+    CHECK(strstr(text, "\"fault_records_off\""));
+    CHECK(!strstr(text, "\"fault_armed\""));
     return 0;
 }
 

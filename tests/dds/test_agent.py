@@ -268,17 +268,41 @@ def test_realtime_waits_at_most_the_timeout(agents, connect):
     assert ags[0].read_stats()["timeouts"] >= 1
 
 
-def test_health_deadline_miss_is_traced(agents, connect):
-    ags = agents(2, extra=["--deadline-ms", "100"])
-    c1 = connect(ags[0])
-    c1.send(xch.HEALTH, 0, 0, xch.pack_health(membership=0b11))
+def test_health_deadline_miss_is_traced_while_this_node_flies(agents, connect):
+    """Emulated time: node 1's health stops while node 2's io waits for a frame's agreement
+    (node 1's inputs never come): a miss of node 1, traced once per episode."""
+    ags = agents(2, extra=["--deadline-ms", "100", "--lease-ms", "60000"])
+    c1, c2 = connect(ags[0]), connect(ags[1])
+    for c in (c1, c2):
+        c.send(xch.HEALTH, 0, 0, xch.pack_health(membership=0b11))
+    exchange_round({1: c1, 2: c2}, 0, {1: 0b11, 2: 0b11})
+    c2.send_inputs(1, 50_000_000, inputs_for(2, 1, 0b11))  # waits for node 1's frame 1
     time.sleep(0.6)  # no more health from node 1
     c1.send(xch.HEALTH, 12, 0, xch.pack_health(membership=0b11))
-    time.sleep(0.4)
+    time.sleep(0.1)
+    c1.send_inputs(1, 50_000_000, inputs_for(1, 1, 0b11))
+    c2.await_agreed(1, 10)
+    c2.send_inputs(2, 100_000_000, inputs_for(2, 2, 0b11))
+    time.sleep(0.6)
     ags[1].stop()
     misses = ags[1].of_kind("dds_deadline_missed", peer="node1")
     assert len(misses) == 2, misses  # one per episode, not one per period
     assert ags[1].read_stats()["peers"][0]["deadline_misses"] >= 4
+
+
+def test_health_deadline_is_no_miss_while_the_run_is_paused(agents, connect):
+    """Emulated time: no io asks for a frame (the bus stopped at the end of the run, or the
+    host stalled everything): the wall-clock deadline says nothing of the peer."""
+    ags = agents(2, extra=["--deadline-ms", "100"])
+    c1, c2 = connect(ags[0]), connect(ags[1])
+    for c in (c1, c2):
+        c.send(xch.HEALTH, 0, 0, xch.pack_health(membership=0b11))
+    exchange_round({1: c1, 2: c2}, 0, {1: 0b11, 2: 0b11})
+    time.sleep(0.6)
+    ags[1].stop()
+    assert not ags[1].of_kind("dds_deadline_missed")
+    st = ags[1].read_stats()
+    assert st["deadline_paused"] >= 1 and st["peers"][0]["deadline_misses"] == 0, st
 
 
 def test_hung_peer_is_not_waited_for_after_a_lease(agents, connect):

@@ -78,6 +78,9 @@ def test_dropped_inputs_are_missing_at_the_others_for_the_spell_only(faulty_agen
         assert s["lost_marks"] == len(spell) and s["partial"] == len(spell), s
         assert s["timeouts"] == 0 and s["faults"] == []
         assert not a.of_kind("fault")
+        # each frame received as lost is traced, with its emulated time
+        missing = [(e["peer"], e["frame"], e["t_ns"]) for e in a.of_kind("xch_peer_missing")]
+        assert missing == [("node2", f, f * FRAME_NS) for f in spell], missing
         # node 2 is not taken for lost or hung: the frames are lost, the node is not
         assert not [e for e in a.of_kind("dds_peer_lost") if e["t_wall_ns"] < t_stop]
 

@@ -98,6 +98,15 @@ def test_realtime_triplex_runs(launches):
     assert run.summary["flown_s"] >= 7.9
     assert run.result.wall_s >= 8.0
     assert run.summary["membership"] == ["node1", "node2", "node3"]
+    # the bus paces the quanta: it says how late it released them, and each node how long
+    # after its wall-clock time each window started (a few hundred microseconds on this
+    # machine; a loose bound here, the oracle's is 2 ms at the p99)
+    bus = json.loads((run.run_dir / "canbus.json").read_text())
+    assert 0 <= bus["release_late_max_us"] < 1e6 and bus["quanta_late"] >= 0, bus
+    starts = run.records("node2.jsonl", "window_start")
+    late = sorted(e["wall_late_ns"] for e in starts)
+    assert len(late) == len(starts) > 100, starts[:3]
+    assert 0 <= late[len(late) // 2] < 50_000_000, late[-5:]
 
 
 def test_ctrl_c_stops_everything(tmp_path):

@@ -90,7 +90,8 @@ enum canbus_rec_type {
     CANBUS_MSG_STOP = 4,  /* either way: the run ends; id = CANBUS_STOP_* reason */
     CANBUS_MSG_ERROR = 5, /* bus -> CAN clients: an error frame on the wire (id = the frame's
                              identifier, t_ns = when, data[0] = sender, data[1] = its state) */
-    CANBUS_MSG_FAULT = 6, /* client -> bus: arm a bus fault (see nodes/README.md) */
+    CANBUS_MSG_FAULT = 6, /* client -> bus: arm a bus fault, if the bus runs with
+                             --fault-records (see nodes/README.md) */
 };
 
 /* ERROR record, in full (bus -> every CAN client, delivered like a frame, in wire order):

@@ -14,7 +14,7 @@ from pathlib import Path
 from ima.launch.options import LaunchOptions
 
 # Not in the deterministic part of a record: what the machine, not the run, decides.
-VOLATILE = ("wall_s", "provenance", "refly", "worker", "run_dir")
+VOLATILE = ("wall_s", "flight_wall_s", "provenance", "refly", "worker", "run_dir")
 
 
 def system_for(campaign_dir: Path, workload: dict, system: str) -> Path:
@@ -67,10 +67,12 @@ def run_one(campaign: dict, run: dict) -> dict:
     golden = cdir / "golden" / campaign["golden_of"][run["run_id"]]
     faults = [grammar.parse(s, f"f{k}") for k, s in enumerate(run["faults"], start=1)]
     refly = 0
+    flight_wall = 0.0
     while True:
         shutil.rmtree(run_dir, ignore_errors=True)
         opts = options(campaign, run, run_dir, faults)
         result = launch_run.launch(opts)
+        flight_wall += result.wall_s
         if result.interrupted:
             raise KeyboardInterrupt(f"{run['run_id']} interrupted")
         targets = {t for inj in result.plan.injections for t in direct_targets(inj)} \
@@ -109,6 +111,7 @@ def run_one(campaign: dict, run: dict) -> dict:
         "measures": measures,
         "oracles": j["oracles"],
         "refly": refly, "wall_s": round(time.monotonic() - t0, 2),
+        "flight_wall_s": round(flight_wall, 2),
         "provenance": provenance.provenance(campaign.get("argv")),
     }
     keep = campaign.get("keep_all") or measures["oracle_violations"] or \

@@ -231,6 +231,8 @@ def run(c: spec.Campaign, opts: RunnerOptions, progress=None) -> list[dict]:
                 fut.result()
                 if progress:
                     progress.golden_done()
+        # grouped by golden run: a worker keeps the last golden run it read (judge.py)
+        todo.sort(key=lambda r: data["golden_of"][r.run_id])
         pending = {ex.submit(run_job, data, r.to_json()): ("run", r.run_id) for r in todo}
         while pending:
             for fut in ex.wait(set(pending)):

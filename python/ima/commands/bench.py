@@ -39,6 +39,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     tri.add_argument("--json", action="store_true", help="print the results as JSON")
     tri.add_argument("--duration", type=positive_int, default=600, metavar="SECONDS",
                      help="emulated flight time (default 600)")
+    camp = targets.add_parser(
+        "campaign", help="the campaign runner: runs per hour of 60 s and 300 s triplex "
+        "flights at -j 1 and -j 2, parallel efficiency, runner overhead, peak memory")
+    camp.add_argument("--json", action="store_true", help="print the results as JSON")
+    camp.add_argument("--runs-60", type=positive_int, default=8, metavar="N",
+                      help="runs of 60 s flights per measurement (default 8)")
+    camp.add_argument("--runs-300", type=positive_int, default=4, metavar="N",
+                      help="runs of 300 s flights per measurement (default 4)")
     cmp_ = targets.add_parser(
         "compare", help="a benchmark of this checkout against another checkout (the previous "
         "main), alternating, pinned to one CPU; per-pair ratios and their median")
@@ -71,4 +79,8 @@ def run(args: argparse.Namespace) -> int:
         from ima.bench import triplex
 
         return triplex.run(json_out=args.json, duration_s=float(args.duration)) or 0
+    if args.target == "campaign":
+        from ima.bench import campaign
+
+        return campaign.run(json_out=args.json, runs_60=args.runs_60, runs_300=args.runs_300)
     raise AssertionError(f"unhandled bench target {args.target}")  # argparse restricts it

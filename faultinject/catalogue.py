@@ -26,7 +26,7 @@ OUTCOMES = ("not_activated", "masked", "detected_recovered", "detected_degraded"
 EVIDENCE = ("hm", "overrun", "port_silent", "port_changed", "frames_stopped", "frames_changed",
             "can_error", "frames_missing", "frames_late", "frames_duplicated", "frames_flood",
             "dds_missing", "sensor_frames", "pilot_frames", "truth_surface", "downlink_mode",
-            "module_reset", "app_report")
+            "module_reset", "app_report", "command_departs")
 ASKED_MODES = ("DIRECT", "AUTOPILOT", "MISSION")
 # What a case may change: the expectations that depend on where and when the fault acts.
 CASE_KEYS = ("evidence", "detect", "latency_ms", "mode", "masked", "outcomes", "known_limit")

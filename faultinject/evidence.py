@@ -30,10 +30,19 @@ class Confirmation:
 
     @property
     def t_ns(self) -> int | None:
-        """The confirmed injection time: when the fault first acted."""
+        """The confirmed injection time: when the fault first acted (for the evidence that
+        marks an activation, ACTIVATION: when it first did so)."""
         if not self.confirmed:
             return None
+        if self.evidence in ACTIVATION:
+            return max(self.applied_t_ns, self.evidence_t_ns)
         return self.applied_t_ns
+
+
+# Evidence that shows when a dormant fault becomes an error: a wrong value equal to the right
+# one (a hard-over where the command already is) is no error until they part.
+ACTIVATION = ("command_departs",)
+AXES = ("ELEV", "AIL", "RUD", "THR")
 
 
 def _applied(ctx: Context, inj: Injection) -> tuple[int | None, str]:
@@ -144,6 +153,8 @@ def _evidence(ctx: Context, inj: Injection, kind: str, t0: int) -> int | None:
         return _io_frames_stop(ctx, node, t0)
     if kind == "frames_changed" and k is not None:
         return _frames_differ(ctx, (ACT_CMD_A + k - 1,), t0)
+    if kind == "command_departs" and k is not None:
+        return _command_departs(ctx, ACT_CMD_A + k - 1, t0)
     if kind == "can_error":
         return _first(ctx.run.bus_kind("can_error", "error_frame", "bus_off"), t0, lambda e: True)
     if kind == "frames_missing":  # the bus's wire: a frame that never reached it, or a receiver
@@ -173,6 +184,25 @@ def _evidence(ctx: Context, inj: Injection, kind: str, t0: int) -> int | None:
     if kind == "app_report":
         return _first(ctx.run.app_messages(node) if node else [], t0,
                       lambda e: e.get("text", "").startswith(f"fault {inj.fid} "))
+    return None
+
+
+def _command_departs(ctx: Context, can_id: int, t0: int) -> int | None:
+    """The first of the node's actuator commands at or after t0 that departs from the golden
+    run's by more than the voter's threshold on some axis (the system model's voting)."""
+    if ctx.golden is None:
+        return None
+    thresholds = ctx.system.voting["thresholds"]
+    gold = {e["t_ns"]: ctx.golden.decode(e) for e in ctx.golden.frames_of(can_id)
+            if e["t_ns"] >= t0}
+    for e in ctx.run.frames_of(can_id):
+        if e["t_ns"] < t0 or e["t_ns"] not in gold:
+            continue
+        run, want = ctx.run.decode(e), gold[e["t_ns"]]
+        for axis in AXES:
+            key = next(k for k in run if k.startswith(axis + "_CMD_"))
+            if abs(run[key] - want[key]) > float(thresholds[axis.lower()]):
+                return e["t_ns"]
     return None
 
 

@@ -96,6 +96,9 @@ def test_dds_stays_on_loopback_and_a_tool_can_listen(launches, tmp_path):
 def test_realtime_triplex_runs(launches):
     run = launches.launch("realtime", duration_s=8.0, seed=SEED, realtime=True)
     assert run.summary["flown_s"] >= 7.9
+    # the run's DDS domain is free again: a campaign's worker launches hundreds of runs
+    from ima import dds
+    assert run.result.domain is not None and run.result.domain not in dds._held
     assert run.result.wall_s >= 8.0
     assert run.summary["membership"] == ["node1", "node2", "node3"]
     # the bus paces the quanta: it says how late it released them, and each node how long

@@ -77,6 +77,19 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None,
                         {(node, "io"): words for node, words in plan.io.items()})
     sock_dir, sock_tmp = socket_dir(run_dir)
     domain = dds.domain_for_run() if len(names) > 1 else None
+    try:
+        return _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp,
+                    domain, on_status, stop_when)
+    finally:
+        # Every process of the run has ended: its DDS domain is free for the next run (a
+        # campaign's worker launches hundreds of runs from one process).
+        if domain is not None:
+            dds.release_domain(domain)
+
+
+def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp, domain,
+         on_status, stop_when) -> LaunchRun:
+    kills, hangs = plan.kills, plan.hangs
     procs_plan = commands.plan(system, opts, run_dir, sock_dir, pilot, deployed.modules, plan,
                                domain)
     (run_dir / "launch.json").write_text(json.dumps({

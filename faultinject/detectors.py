@@ -132,13 +132,15 @@ def fired(ctx: Context, inj: Injection, t0: int) -> dict[str, int]:
     return out
 
 
-def reached_mode(ctx: Context, t0: int, want_mode: str, want_fallback: str | None) -> int | None:
+def reached_mode(ctx: Context, t0: int, want_mode: str,
+                 want_fallback: str | list[str] | None) -> int | None:
     """The first heartbeat at or after t0 that reports the mode (and fallback) wanted."""
     modes, fallbacks = fcs_choices("FCS_MODE"), fcs_choices("FCS_FALLBACK")
     for t, _k, d in ctx.run.fcs_status:
         if t < t0:
             continue
         if modes.get(d.get("FCS_MODE")) == want_mode and (
-                want_fallback is None or fallbacks.get(d.get("FCS_FALLBACK")) == want_fallback):
+                want_fallback is None or fallbacks.get(d.get("FCS_FALLBACK")) in (
+                    [want_fallback] if isinstance(want_fallback, str) else want_fallback)):
             return t
     return None

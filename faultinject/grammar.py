@@ -194,13 +194,21 @@ def from_yaml_file(path: Path, first: int = 1) -> list[Fault]:
         raise FaultSpecError(f"{path}: cannot read: {exc}") from exc
     except yaml.YAMLError as exc:
         raise FaultSpecError(f"{path}: not valid YAML: {exc}") from exc
-    errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(doc),
-                    key=lambda e: list(map(str, e.absolute_path)))
-    if errors:
-        e = errors[0]
-        where = ".".join(str(p) for p in e.absolute_path) or "(top level)"
-        raise FaultSpecError(f"{path}: {where}: {e.message}")
+    e = first_schema_error(jsonschema.Draft202012Validator(_schema()), doc)
+    if e is not None:
+        raise FaultSpecError(f"{path}: {e}")
     return from_items(doc["faults"], str(path), first)
+
+
+def first_schema_error(validator, doc) -> str | None:
+    """The first error of a document, as `PATH: MESSAGE`; of an item that matches none of its
+    alternatives (oneOf), the most relevant error of the alternatives, which names the bad
+    value."""
+    found = [jsonschema.exceptions.best_match([e]) for e in validator.iter_errors(doc)]
+    if not found:
+        return None
+    e = sorted(found, key=lambda e: list(map(str, e.absolute_path)))[0]
+    return f"{'.'.join(str(p) for p in e.absolute_path) or '(top level)'}: {e.message}"
 
 
 def from_items(items: list[dict], origin: str, first: int = 1) -> list[Fault]:

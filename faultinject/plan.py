@@ -79,6 +79,9 @@ def check_target(system, f: Fault) -> None:
     if t.node not in ("world", "bus", "*") and t.node not in names:
         raise FaultSpecError(f"fault {f.fid} ({f.spec()}): no node '{t.node}' in {system.name} "
                              f"(nodes: {', '.join(names)})")
+    if t.node == "bus" and f.cls == "transceiver_cut":
+        raise FaultSpecError(f"fault {f.fid} ({f.spec()}): transceiver_cut cuts one node's "
+                             "transceiver: write NODE:, not bus:")
     if fc.injector == "dds" and len(names) < 2:
         raise FaultSpecError(f"fault {f.fid} ({f.spec()}): {system.name} has one node and no "
                              "DDS between nodes")

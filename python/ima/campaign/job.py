@@ -52,8 +52,9 @@ def host_stalls(run_dir: Path, targets: set[tuple[str, str]]) -> list[dict]:
     return out
 
 
-def run_one(campaign: dict, run: dict) -> dict:
-    """Flies and judges one run; returns its record (results.jsonl)."""
+def run_one(campaign: dict, run: dict, run_dir: Path | None = None) -> dict:
+    """Flies and judges one run (into run_dir, by default the campaign folder's
+    runs/RUN_ID); returns its record (results.jsonl)."""
     from faultinject import grammar
     from faultinject.judge import judge
     from faultinject.oracles import direct_targets
@@ -63,7 +64,7 @@ def run_one(campaign: dict, run: dict) -> dict:
 
     t0 = time.monotonic()
     cdir = Path(campaign["dir"])
-    run_dir = cdir / "runs" / run["run_id"]
+    run_dir = Path(run_dir) if run_dir is not None else cdir / "runs" / run["run_id"]
     golden = cdir / "golden" / campaign["golden_of"][run["run_id"]]
     faults = [grammar.parse(s, f"f{k}") for k, s in enumerate(run["faults"], start=1)]
     refly = 0

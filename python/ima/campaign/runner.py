@@ -182,15 +182,16 @@ def prepare(c: spec.Campaign, opts: RunnerOptions) -> dict:
     if (out / RESULTS).exists() and not opts.resume:
         raise ImaError(f"{out} already holds a campaign's results: --resume to go on with it, "
                        "or another --out", exit_code=2)
+    doc = spec.resolved_doc(c)
     if opts.resume and (out / "campaign.json").is_file():
         try:
-            before = json.loads((out / "campaign.json").read_text())["runs"]
-        except (OSError, ValueError, KeyError):
-            before = None
-        if before is not None and before != [r.to_json() for r in c.runs]:
-            raise ImaError(f"{out}: planned with another version of {c.path.name}: its runs "
-                           "differ; resume with the campaign as it was, or use another --out",
-                           exit_code=2)
+            before = json.loads((out / "campaign.json").read_text())
+        except (OSError, ValueError):
+            before = {}
+        if before.get("doc", doc) != doc or before.get("runs") != [r.to_json() for r in c.runs]:
+            raise ImaError(f"{out}: planned with another version of {c.path.name} (its "
+                           "content or its runs differ); resume with the campaign as it was, "
+                           "or use another --out", exit_code=2)
     out.mkdir(parents=True, exist_ok=True)
     (out / "runs").mkdir(exist_ok=True)
     (out / "campaign.yaml").write_text(
@@ -203,7 +204,8 @@ def prepare(c: spec.Campaign, opts: RunnerOptions) -> dict:
                                       w.mission_feed)
     (out / "campaign.json").write_text(json.dumps(
         {"campaign": c.name, "file": str(c.path), "system": str(c.system),
-         "duration_s": c.duration_s, "runs": [r.to_json() for r in c.runs]}, indent=1) + "\n")
+         "duration_s": c.duration_s, "doc": doc, "runs": [r.to_json() for r in c.runs]},
+        indent=1) + "\n")
     return data
 
 

@@ -88,12 +88,9 @@ def load(path: Path) -> Campaign:
         raise CampaignError(f"{path}: cannot read: {exc}") from exc
     except yaml.YAMLError as exc:
         raise CampaignError(f"{path}: not valid YAML: {exc}") from exc
-    errors = sorted(jsonschema.Draft202012Validator(_schema()).iter_errors(doc),
-                    key=lambda e: list(map(str, e.absolute_path)))
-    if errors:
-        e = errors[0]
-        where = ".".join(str(p) for p in e.absolute_path) or "(top level)"
-        raise CampaignError(f"{path}: {where}: {e.message}")
+    e = grammar.first_schema_error(jsonschema.Draft202012Validator(_schema()), doc)
+    if e is not None:
+        raise CampaignError(f"{path}: {e}")
     base = Path(path).resolve().parent
     workloads = {}
     for name, w in doc["workloads"].items():

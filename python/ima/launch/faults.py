@@ -12,7 +12,7 @@ from pathlib import Path
 
 from faultinject import grammar
 from faultinject.model import Fault, Target, Trigger
-from faultinject.plan import Plan, compile_plan
+from faultinject.plan import Plan, check_target, compile_plan
 from faultinject.resolve import resolve
 from ima.launch.options import LaunchOptions
 
@@ -44,6 +44,8 @@ def prepare(opts: LaunchOptions, system, run_dir: Path,
     """The faults resolved and compiled. A trigger on a condition is resolved by runs of the
     system with the faults resolved so far (run_dir/resolve-K/, removed after)."""
     faults = requested(opts)
+    for f in faults:  # a bad target is refused before any run resolves a condition
+        check_target(system, f)
     runs = 0
 
     def run_once(resolved: list[Fault], until: Callable[[dict], bool]) -> Path:

@@ -13,9 +13,11 @@ from ima.launch.options import LaunchOptions, LaunchRun
 
 
 def golden_options(opts: LaunchOptions, run_dir: Path) -> LaunchOptions:
-    """The run without its faults, into run_dir."""
+    """The run without its faults (nor the test-only switches that plant violations), into
+    run_dir, with the port hashes the oracles compare."""
     return dataclasses.replace(opts, faults=[], kill=[], hang=[], wrong_output=[],
-                               run_dir=run_dir, judge=False, golden=None)
+                               test_switches=[], run_dir=run_dir, judge=False, golden=None,
+                               port_hashes=True)
 
 
 def fly_golden(opts: LaunchOptions, run_dir: Path) -> Path:

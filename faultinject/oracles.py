@@ -69,7 +69,13 @@ def temporal_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
     if ctx.golden is None:
         return {"verdict": "n/a", "why": "no golden run"}
     realtime = ctx.run.realtime and ctx.golden.realtime
-    findings, checked, measured = [], 0, []
+    findings, checked, measured, limits = [], 0, [], []
+    # In real time the modules share the host's CPUs: with fewer CPUs than modules, a faulty
+    # partition that burns its whole budget stretches its own window in wall time, and its
+    # module's next windows start late. That is the host, not the partitioning: a known limit
+    # there; lateness in any other module stays a violation.
+    faulty_nodes = {n for inj in ctx.plan.injections for n, _ in direct_targets(inj)}
+    oversubscribed = ctx.run.host_cpus is not None and ctx.run.host_cpus < len(ctx.node_names)
     for node in ctx.node_names:
         for p in ctx.system.partitions:
             if _excluded(ctx, node, p.name):
@@ -79,7 +85,15 @@ def temporal_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
             if realtime:
                 m = _realtime_check(ctx, node, p.name)
                 measured.append(m)
-                if m["verdict"] == "fail":
+                if m["verdict"] == "fail" and m["why"].startswith("window-start lateness b") and \
+                        node in faulty_nodes and oversubscribed:
+                    m["verdict"] = "known_limit"
+                    m["why"] = (f"window-start lateness in the faulty partition's module: a "
+                                f"window that uses its whole CPU budget takes longer on a host "
+                                f"with fewer CPUs ({ctx.run.host_cpus}) than modules "
+                                f"({len(ctx.node_names)})")
+                    limits.append(m)
+                elif m["verdict"] == "fail":
                     findings.append(m)
                 continue
             run, gold = ctx.run.windows(node, p.name), ctx.golden.windows(node, p.name)
@@ -95,6 +109,7 @@ def temporal_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
     if realtime:
         out["tolerance"] = REALTIME_TOLERANCE
         out["measured"] = measured
+        out["known_limit"] = limits
     return out
 
 

@@ -130,6 +130,12 @@ class RunTraces:
     def realtime(self) -> bool:
         return bool(self.launch.get("realtime"))
 
+    @property
+    def host_cpus(self) -> int | None:
+        """The CPUs the run could use (None: a run recorded before launch.json said)."""
+        n = self.launch.get("host_cpus")
+        return n if isinstance(n, int) and n > 0 else None
+
     def port_hashes(self, node: str) -> dict[tuple[str, str], list[tuple[int, str]]]:
         """(partition, port) -> [(t_ns, hash)] of the node's source ports, window by window."""
         cache = self.__dict__.setdefault("_port_hashes", {})

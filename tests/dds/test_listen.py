@@ -4,8 +4,10 @@
 from __future__ import annotations
 
 import json
+import queue
 import subprocess
 import sys
+import threading
 import time
 
 from ima.dds import dds_env, xch
@@ -62,16 +64,42 @@ def test_listener_reports_instance_state_changes(agents, connect, domain):
     c1, c2 = connect(ags[0]), connect(ags[1])
     listener = subprocess.Popen(
         [sys.executable, "-m", "ima.dds.listen", "--domain", str(domain), "--topic",
-         "rpas_CrossChannelInputs", "--count", "4", "--timeout", "30", "--json"],
+         "rpas_CrossChannelInputs", "--timeout", "60", "--json"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=dds_env())
-    time.sleep(1.0)  # matched by then
-    for c in (c1, c2):
-        c.exchange(0, 0, xch.Inputs(valid=1, wait_mask=0), timeout=5)  # waits for nobody
-    c1.close()  # node 1's io goes: its agent disposes node 1's inputs
-    time.sleep(0.2)
-    ags[1].stop()  # node 2's agent ends: its writer goes
-    out, err = listener.communicate(timeout=40)
-    assert listener.returncode == 0, err
-    got = {(e.get("node") or e["sample"]["node"], e.get("instance_state", "valid"))
-           for e in map(json.loads, out.splitlines())}
+    lines: queue.Queue = queue.Queue()
+    threading.Thread(target=lambda: [lines.put(x) for x in listener.stdout], daemon=True).start()
+    got: set = set()
+
+    def until(wanted, poke=None, within=30.0):
+        end = time.monotonic() + within
+        while not wanted <= got and time.monotonic() < end:
+            if poke:
+                poke()
+            try:
+                e = json.loads(lines.get(timeout=0.2))
+            except queue.Empty:
+                continue
+            node = e["sample"]["node"] if e["valid"] else e["node"]
+            if e["valid"]:
+                got.add((node, "valid"))
+            if e["instance_state"] != "alive":  # on its own sample, or on one still unread
+                got.add((node, e["instance_state"]))
+        assert wanted <= got, (got, listener.poll() is not None and listener.stderr.read())
+
+    frame = iter(range(1, 10_000))
+
+    def publish():  # until the listener has matched the writers, samples may go unseen
+        f = next(frame)
+        for c in (c1, c2):
+            c.exchange(f, f * 50_000_000, xch.Inputs(valid=1, wait_mask=0), timeout=5)
+
+    try:
+        until({(1, "valid"), (2, "valid")}, poke=publish)
+        c1.close()  # node 1's io goes: its agent disposes node 1's inputs
+        until({(1, "disposed")})
+        ags[1].stop()  # node 2's agent ends: its writer goes
+        until({(2, "no_writers")})
+    finally:
+        listener.terminate()
+        listener.wait(timeout=10)
     assert got == {(1, "valid"), (1, "disposed"), (2, "valid"), (2, "no_writers")}

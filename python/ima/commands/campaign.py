@@ -59,31 +59,53 @@ def _jobs(n: int | None) -> int:
 
 
 class _Progress:
-    """The live progress bar: goldens, then runs with ETA and counts by outcome."""
+    """The live progress bar: goldens, then runs with ETA and counts by outcome. Into a log
+    (stderr not a terminal), one line per golden run and per run instead."""
 
     def __init__(self, console) -> None:
         from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
+        self.console = console
+        self.live = console.is_terminal
         self.p = Progress(TextColumn("[bold]{task.description}"), BarColumn(),
                           TextColumn("{task.completed}/{task.total}"), TimeRemainingColumn(),
                           TextColumn("{task.fields[counts]}"), console=console, transient=True)
         self.golden = self.runs = None
+        self.totals = [0, 0]  # golden runs, runs
+        self.finished = [0, 0]
 
     def start(self, goldens: int, runs: int, done: int) -> None:
-        self.p.start()
+        self.totals = [goldens, runs]
+        if self.live:
+            self.p.start()
         self.golden = self.p.add_task("golden runs", total=goldens, counts="")
         self.runs = self.p.add_task("runs", total=runs, counts=f"({done} done before)"
                                     if done else "")
 
     def golden_done(self) -> None:
         self.p.advance(self.golden)
+        self.finished[0] += 1
+        if not self.live:
+            self.console.print(f"golden run {self.finished[0]}/{self.totals[0]} flown",
+                               highlight=False)
 
     def run_done(self, record: dict, counts, elapsed: float) -> None:
         text = "  ".join(f"{k.replace('_', ' ')} {v}" for k, v in sorted(counts.items()))
         self.p.update(self.runs, advance=1, counts=text)
+        self.finished[1] += 1
+        if not self.live:
+            n, total = self.finished[1], self.totals[1]
+            eta = elapsed / n * (total - n)
+            m = record["measures"]
+            bad = f", VIOLATED {', '.join(m['oracle_violations'])}" \
+                if m["oracle_violations"] else ""
+            self.console.print(f"[{n}/{total}] {record['run_id']}: {m['outcome']}{bad} "
+                               f"({elapsed:.0f} s, about {eta:.0f} s left)", highlight=False,
+                               soft_wrap=True)
 
     def stop(self) -> None:
-        self.p.stop()
+        if self.live:
+            self.p.stop()
 
 
 def _rerun(args: argparse.Namespace) -> int:

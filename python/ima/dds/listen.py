@@ -50,6 +50,10 @@ def _to_json(topic: str, sample, t_wall_ns: int) -> dict:
         out["node"] = getattr(sample.key_sample, "node", None)
         return out
     out["valid"] = True
+    # A state change that arrives while a sample is still unread marks that sample instead
+    # of adding one: its instance_state says "disposed" or "no_writers".
+    if info is not None:
+        out["instance_state"] = INSTANCE_STATES.get(int(info.instance_state), "?")
     out["sample"] = dataclasses.asdict(sample)
     return out
 
@@ -62,7 +66,8 @@ def _to_text(topic: str, sample) -> str:
     d = dataclasses.asdict(sample)
     head = f"{topic} node{d.pop('node')} frame {d.pop('frame')} t {d.pop('t_ns') / 1e9:.3f} s"
     rest = " ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}" for k, v in d.items())
-    return f"{head}: {rest}"
+    state = INSTANCE_STATES.get(int(info.instance_state), "?") if info is not None else "alive"
+    return f"{head}: {rest}" + ("" if state == "alive" else f" [{state}]")
 
 
 def listen(domain: int, topics: list[str] | None = None, count: int | None = None,

@@ -96,7 +96,8 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
         "kind": opts.kind, "system": str(system.path), "nodes": names, "seed": opts.seed,
         "duration_s": opts.duration_s, "pilot": str(pilot), "turbulence": opts.turbulence,
         "wind_kt": opts.wind_kt, "wind_from_deg": opts.wind_from_deg, "realtime": opts.realtime,
-        "quantum_us": opts.quantum_us, "dds_domain": domain,
+        "host_cpus": len(os.sched_getaffinity(0)), "quantum_us": opts.quantum_us,
+        "dds_domain": domain,
         "dds_config": str(system.dds["config"]),
         "faults": [{"id": f.fid, "spec": f.spec(), "class": f.cls, "t_s": f.trigger.at_s}
                    for f in plan.faults],

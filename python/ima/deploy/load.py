@@ -505,12 +505,9 @@ class _Builder:
         if not dbc.is_file():
             raise self.fail(at, f"no such file: {dbc}")
         try:
-            import cantools  # noqa: PLC0415 (slow to import; only needed here)
-
-            db = cantools.database.load_file(str(dbc), database_format="dbc")
+            return dict(_dbc_ids(str(dbc.resolve()), dbc.stat().st_mtime_ns))
         except Exception as exc:  # cantools raises many kinds for a bad file
             raise self.fail(at, f"cannot read {dbc}: {exc}") from exc
-        return {m.name: m.frame_id for m in db.messages}
 
     def expand(self, at: tuple, items: list[str], node: Node, nodes: list[Node],
                messages: dict[str, int], dbc: Path, sending: bool) -> list[str]:
@@ -585,3 +582,12 @@ class _Builder:
                                 f"{node.channel}) in {can['dbc'].name}")
         return {"heartbeat": m["heartbeat"], "missed_frames": m["missed_frames"]}
 
+
+@functools.lru_cache(maxsize=8)
+def _dbc_ids(path: str, mtime_ns: int) -> tuple[tuple[str, int], ...]:
+    """A DBC's (message name, frame identifier), read once per version of the file (a
+    campaign loads the same model for every run)."""
+    import cantools  # noqa: PLC0415 (slow to import; only needed here)
+
+    db = cantools.database.load_file(path, database_format="dbc")
+    return tuple((m.name, m.frame_id) for m in db.messages)

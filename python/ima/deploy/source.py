@@ -54,6 +54,9 @@ class Source:
         return sorted({f.path.resolve() for f in self.owners.values()} - {self.main.path.resolve()})
 
 
+_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
 def _read(path: Path) -> _File:
     if not path.is_file():
         raise SystemModelError(f"{path}: no such system file")
@@ -62,8 +65,14 @@ def _read(path: Path) -> _File:
     except (OSError, UnicodeDecodeError) as exc:
         raise SystemModelError(f"{path}: cannot read: {exc}") from exc
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-        doc = yaml.safe_load(text)
+        # Parsed once (libyaml's parser when PyYAML has it): the nodes keep the lines that
+        # errors name, and the document is constructed from them.
+        loader = _LOADER(text)
+        try:
+            root = loader.get_single_node()
+            doc = loader.construct_document(root) if root is not None else None
+        finally:
+            loader.dispose()
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"{path}:{mark.line + 1}" if mark else str(path)

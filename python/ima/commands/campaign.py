@@ -73,6 +73,7 @@ class _Progress:
         self.golden = self.runs = None
         self.totals = [0, 0]  # golden runs, runs
         self.finished = [0, 0]
+        self.runs_t0: float | None = None  # when the runs began (the ETA counts from there)
 
     def start(self, goldens: int, runs: int, done: int) -> None:
         self.totals = [goldens, runs]
@@ -93,9 +94,14 @@ class _Progress:
         text = "  ".join(f"{k.replace('_', ' ')} {v}" for k, v in sorted(counts.items()))
         self.p.update(self.runs, advance=1, counts=text)
         self.finished[1] += 1
+        now = time.monotonic()
+        if self.runs_t0 is None:
+            self.runs_t0 = now
         if not self.live:
             n, total = self.finished[1], self.totals[1]
-            eta = elapsed / n * (total - n)
+            # The pace of the runs since the first ended (golden runs take longer).
+            pace = (now - self.runs_t0) / (n - 1) if n > 1 else elapsed
+            eta = pace * (total - n)
             m = record["measures"]
             bad = f", VIOLATED {', '.join(m['oracle_violations'])}" \
                 if m["oracle_violations"] else ""

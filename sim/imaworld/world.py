@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ima.canbus import proto
+from ima.canbus.client import BusError
 from ima.canbus.codec import BY_ID, MESSAGES, choices
 
 from .actuators import CHANNELS, Actuators, LowestLiveChannel, VotingSelector, safe_position
@@ -451,6 +452,13 @@ class World:
             self.t_end = t
             self.stop_reason = f"crash: {c}"
             bus.stop()
+        except BusError:
+            # The bus went away (ended by the launcher, or died): what was flown is recorded
+            # all the same, then the error is told.
+            self.stop_reason = "bus lost"
+            self.t_now = max(self.t_now, self.t_end)
+            self.finish(time.perf_counter() - wall0)
+            raise
         self.t_now = max(self.t_now, self.t_end)
         self.finish(time.perf_counter() - wall0)
         return 0

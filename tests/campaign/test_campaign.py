@@ -158,3 +158,23 @@ def test_a_bad_campaign_is_refused_naming_where(tmp_path, change, where):
     assert p.returncode == 2, p.stderr
     assert where in p.stderr and p.stderr.count("\n") <= 2, p.stderr
     assert not (tmp_path / "o" / "results.jsonl").exists()
+
+
+def test_a_run_that_cannot_be_flown_fails_alone(first, tmp_path):
+    """A condition that never comes true: that run is a failure with its reason, the others
+    are flown and judged, and the campaign ends with exit status 1."""
+    out = tmp_path / "out"
+    faults = [CAMPAIGN["faults"][2],
+              {"name": "never", "specs": ["nav_fcs@node1:cpu_overrun@mode=CONTINGENCY+1~1"]}]
+    p = _ima("campaign", _campaign(tmp_path, faults=faults, duration_s=6), "--out", out,
+             "-j", "2", check=False)
+    assert p.returncode == 1, p.stderr[-2000:]
+    recs = {r["group"]: r for r in _records(out)}
+    assert set(recs) == {"gps_loss", "never"}
+    bad = recs["never"]["measures"]
+    assert bad["outcome"] == "not_activated" and bad["oracle_violations"] == ["run"]
+    assert "never came" in bad["error"] and recs["never"]["run_dir"]
+    assert recs["gps_loss"]["measures"]["oracle_violations"] == []
+    suite = ET.parse(out / "junit.xml").getroot()
+    failed = [c.get("name") for c in suite.iter("testcase") if c.find("failure") is not None]
+    assert failed == [recs["never"]["run_id"]]

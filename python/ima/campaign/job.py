@@ -11,6 +11,7 @@ import shutil
 import time
 from pathlib import Path
 
+from ima.errors import ImaError
 from ima.launch.options import LaunchOptions
 
 # Not in the deterministic part of a record: what the machine, not the run, decides.
@@ -72,7 +73,12 @@ def run_one(campaign: dict, run: dict, run_dir: Path | None = None) -> dict:
     while True:
         shutil.rmtree(run_dir, ignore_errors=True)
         opts = options(campaign, run, run_dir, faults)
-        result = launch_run.launch(opts)
+        try:
+            result = launch_run.launch(opts)
+        except ImaError as exc:
+            # A run that could not be flown (a condition that never came, a process that
+            # would not start) is a failed run of the campaign, not the campaign's end.
+            return _unflown(campaign, run, run_dir, faults, exc, t0)
         flight_wall += result.wall_s
         if result.interrupted:
             raise KeyboardInterrupt(f"{run['run_id']} interrupted")
@@ -121,6 +127,34 @@ def run_one(campaign: dict, run: dict, run_dir: Path | None = None) -> dict:
     if not keep:
         shutil.rmtree(run_dir, ignore_errors=True)
     return record
+
+
+def _unflown(campaign: dict, run: dict, run_dir: Path, faults: list, exc: Exception,
+             t0: float) -> dict:
+    """The record of a run that could not be flown: no fault activated, the run a failure
+    (its oracle_violations name `run`), its folder kept."""
+    from ima import provenance
+
+    return {
+        "run_id": run["run_id"], "group": run["group"], "classes": run["classes"],
+        "workload": run["workload"], "seed": run["seed"], "weight": run["weight"],
+        "fault": {"specs": run["faults"],
+                  "faults": [{"id": f.fid, "class": f.cls, "spec": f.spec(),
+                              "requested_t_s": f.trigger.at_s} for f in faults]},
+        "activation": {"confirmed": False,
+                       "faults": [{"id": f.fid, "applied": False, "t_s": None, "evidence": []}
+                                  for f in faults]},
+        "readouts": {"faults": [{"id": f.fid, "detected_by": [], "latency_ms": None,
+                                 "outcome": "not_activated", "expected_outcomes": []}
+                                for f in faults],
+                     "degraded": [], "truth_identical": False, "hm": []},
+        "measures": {"outcome": "not_activated", "oracles": {}, "oracle_violations": ["run"],
+                     "known_limit": [], "error": str(exc)},
+        "oracles": {},
+        "refly": 0, "wall_s": round(time.monotonic() - t0, 2), "flight_wall_s": 0.0,
+        "provenance": provenance.provenance(campaign.get("argv")),
+        "run_dir": str(run_dir),
+    }
 
 
 def _hm(run_dir: Path, node: str) -> list[dict]:

@@ -58,6 +58,8 @@ def host_limits(records: list[dict]) -> list[dict]:
 
 def failure_of(record: dict) -> str | None:
     m = record["measures"]
+    if m.get("error"):
+        return "the run could not be flown: " + m["error"]
     if m["oracle_violations"]:
         return "oracle violation: " + ", ".join(m["oracle_violations"])
     if m["outcome"] == "undetected_hazardous" and not m.get("known_limit"):

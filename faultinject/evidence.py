@@ -188,21 +188,34 @@ def _evidence(ctx: Context, inj: Injection, kind: str, t0: int) -> int | None:
 
 
 def _command_departs(ctx: Context, can_id: int, t0: int) -> int | None:
-    """The first of the node's actuator commands at or after t0 that departs from the golden
-    run's by more than the voter's threshold on some axis (the system model's voting)."""
+    """The first of the node's actuator commands at or after t0 from which the commands depart
+    from the golden run's by more than the voter's threshold on some axis for `persist`
+    commands in a row (the system model's voting): an error the voter can see, not a brush
+    past the threshold for a frame."""
     if ctx.golden is None:
         return None
     thresholds = ctx.system.voting["thresholds"]
+    persist = max(1, int(ctx.system.voting.get("persist", 1)))
     gold = {e["t_ns"]: ctx.golden.decode(e) for e in ctx.golden.frames_of(can_id)
             if e["t_ns"] >= t0}
+    first, run_len = None, 0
     for e in ctx.run.frames_of(can_id):
         if e["t_ns"] < t0 or e["t_ns"] not in gold:
             continue
         run, want = ctx.run.decode(e), gold[e["t_ns"]]
+        departs = False
         for axis in AXES:
             key = next(k for k in run if k.startswith(axis + "_CMD_"))
             if abs(run[key] - want[key]) > float(thresholds[axis.lower()]):
-                return e["t_ns"]
+                departs = True
+                break
+        if not departs:
+            first, run_len = None, 0
+            continue
+        first = e["t_ns"] if first is None else first
+        run_len += 1
+        if run_len >= persist:
+            return first
     return None
 
 

@@ -85,7 +85,7 @@ def temporal_isolation(ctx: Context, conf: list[Confirmation]) -> dict:
             if realtime:
                 m = _realtime_check(ctx, node, p.name)
                 measured.append(m)
-                if m["verdict"] == "fail" and m["why"].startswith("window-start lateness b") and \
+                if m["verdict"] == "fail" and m["exceeded"] == ["window-start lateness"] and \
                         node in faulty_nodes and oversubscribed:
                     m["verdict"] = "known_limit"
                     m["why"] = (f"window-start lateness in the faulty partition's module: a "
@@ -129,6 +129,7 @@ def _realtime_check(ctx: Context, node: str, partition: str) -> dict:
             bad.append("CPU time")
     m["verdict"] = "fail" if bad else "pass"
     if bad:
+        m["exceeded"] = bad
         m["why"] = ", ".join(bad) + " beyond the tolerance"
     return m
 

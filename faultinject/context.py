@@ -29,13 +29,7 @@ class Context:
         return [n.name for n in self.system.nodes]
 
     def _mode_at(self, traces: RunTraces, field: str, t_ns: int) -> str | None:
-        names = fcs_choices(field)
-        value = None
-        for t, _k, d in traces.fcs_status:
-            if t > t_ns:
-                break
-            value = names.get(d.get(field))
-        return value
+        return fcs_choices(field).get(traces.fcs_at(field, t_ns))
 
     def asked_mode(self, t_ns: int) -> str | None:
         """The mode the pilot asks for at t_ns, from the golden run's FCS heartbeats (the

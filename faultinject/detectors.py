@@ -77,20 +77,20 @@ def _status_change(ctx: Context, t0: int, field: str, changed) -> int | None:
     """The first heartbeat at or after t0 whose `field` changed (changed(expected, now)) from
     what the same replica reported in the golden run at that time (the workload's own mode
     changes are no detection); without a golden run, from its value before t0."""
+    first = None
     if ctx.golden is not None:
-        gold: dict[int, tuple[list[int], list]] = {}
-        for t, k, d in ctx.golden.fcs_status:
-            times, values = gold.setdefault(k, ([], []))
-            times.append(t)
-            values.append(d.get(field))
-        for t, k, d in ctx.run.fcs_status:
-            if t < t0 or k not in gold:
+        gold = ctx.golden.fcs_field(field)
+        for k, (run_times, run_values) in ctx.run.fcs_field(field).items():
+            if k not in gold:
                 continue
             times, values = gold[k]
-            i = bisect.bisect_right(times, t) - 1
-            if i >= 0 and changed(values[i], d.get(field)):
-                return t
-        return None
+            for i in range(bisect.bisect_left(run_times, t0), len(run_times)):
+                j = bisect.bisect_right(times, run_times[i]) - 1
+                if j >= 0 and changed(values[j], run_values[i]):
+                    found = run_times[i]
+                    first = found if first is None else min(first, found)
+                    break
+        return first
     before: dict[int, int] = {}
     for t, k, d in ctx.run.fcs_status:
         v = d.get(field)
@@ -136,11 +136,14 @@ def reached_mode(ctx: Context, t0: int, want_mode: str,
                  want_fallback: str | list[str] | None) -> int | None:
     """The first heartbeat at or after t0 that reports the mode (and fallback) wanted."""
     modes, fallbacks = fcs_choices("FCS_MODE"), fcs_choices("FCS_FALLBACK")
-    for t, _k, d in ctx.run.fcs_status:
-        if t < t0:
-            continue
-        if modes.get(d.get("FCS_MODE")) == want_mode and (
-                want_fallback is None or fallbacks.get(d.get("FCS_FALLBACK")) in (
-                    [want_fallback] if isinstance(want_fallback, str) else want_fallback)):
-            return t
-    return None
+    wanted = None if want_fallback is None else (
+        [want_fallback] if isinstance(want_fallback, str) else want_fallback)
+    fb = ctx.run.fcs_field("FCS_FALLBACK")
+    first = None
+    for k, (times, values) in ctx.run.fcs_field("FCS_MODE").items():
+        for i in range(bisect.bisect_left(times, t0), len(times)):
+            if modes.get(values[i]) == want_mode and (
+                    wanted is None or fallbacks.get(fb[k][1][i]) in wanted):
+                first = times[i] if first is None else min(first, times[i])
+                break
+    return first

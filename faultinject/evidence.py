@@ -5,10 +5,12 @@ word alone. A fault requested but unconfirmed is reported as such, never as a pa
 
 from __future__ import annotations
 
+import bisect
 from dataclasses import dataclass
 
 from faultinject.context import Context
 from faultinject.plan import Injection
+from faultinject.traces import parse_lines, t_ns_of
 
 SENSOR_IDS = {"gps": (0x9100190, 0x9100194), "ahrs": (0x9100320, 0x9100324, 0x9100328),
               "air": (0x91004B0,)}
@@ -70,13 +72,19 @@ def _first(events, t0: int, pred) -> int | None:
 
 
 def _frames_differ(ctx: Context, ids: tuple[int, ...], t0: int) -> int | None:
-    """The first frame time at which the run's frames of `ids` differ from the golden run's."""
+    """The first frame time at which the run's frames of `ids` differ from the golden run's
+    (the records compared as bytes first: only from the first that differs are they parsed)."""
     if ctx.golden is None:
         return None
-    run = [(e["t_ns"], e["id"], e["data"]) for e in ctx.run.frames if e["id"] in ids
-           and e["t_ns"] >= t0]
-    gold = [(e["t_ns"], e["id"], e["data"]) for e in ctx.golden.frames if e["id"] in ids
-            and e["t_ns"] >= t0]
+    raw_run, raw_gold = ctx.run.frame_lines(*ids), ctx.golden.frame_lines(*ids)
+    i = min(bisect.bisect_left(raw_run, t0, key=t_ns_of),
+            bisect.bisect_left(raw_gold, t0, key=t_ns_of))
+    while i < len(raw_run) and i < len(raw_gold) and raw_run[i] == raw_gold[i]:
+        i += 1
+    if i == len(raw_run) == len(raw_gold):
+        return None
+    run = [(e["t_ns"], e["id"], e["data"]) for e in parse_lines(raw_run[i:]) if e["t_ns"] >= t0]
+    gold = [(e["t_ns"], e["id"], e["data"]) for e in parse_lines(raw_gold[i:]) if e["t_ns"] >= t0]
     for a, b in zip(run, gold, strict=False):
         if a != b:
             return min(a[0], b[0])
@@ -91,14 +99,15 @@ def _io_frames_stop(ctx: Context, node: str | None, t0: int) -> int | None:
     if node is None:
         return None
     name = f"{node}/io"
-    mine = [(e["t_ns"], e["id"]) for e in ctx.run.frames if e.get("from") == name]
+    mine = [(e["t_ns"], e["id"]) for e in ctx.run.frames_from(name)]
     if ctx.golden is not None:
         sent = {x for x in mine if x[0] >= t0}
-        return next((t for t, i in ((e["t_ns"], e["id"]) for e in ctx.golden.frames
-                                    if e.get("from") == name and e["t_ns"] >= t0)
+        return next((t for t, i in ((e["t_ns"], e["id"]) for e in ctx.golden.frames_from(name)
+                                    if e["t_ns"] >= t0)
                      if (t, i) not in sent), None)
     after = [t for t, _ in mine if t >= t0]
-    end = ctx.run.frames[-1]["t_ns"] if ctx.run.frames else 0
+    last = ctx.run.last_frame_t_ns()
+    end = last if last is not None else 0
     if not mine or (after and after[-1] > end - 200_000_000):
         return None  # still sending near the end
     return max(t0, mine[-1][0])
@@ -142,9 +151,9 @@ def _evidence(ctx: Context, inj: Injection, kind: str, t0: int) -> int | None:
     if kind in ("port_silent", "port_changed"):
         if ctx.golden is None or node is None:
             return None
-        key = (part, inj.fault.target.port)
-        run = [x for x in ctx.run.port_hashes(node).get(key, []) if x[0] >= t0]
-        gold = [x for x in ctx.golden.port_hashes(node).get(key, []) if x[0] >= t0]
+        port = inj.fault.target.port
+        run = [x for x in ctx.run.port_hashes(node, part).get(port, []) if x[0] >= t0]
+        gold = [x for x in ctx.golden.port_hashes(node, part).get(port, []) if x[0] >= t0]
         if kind == "port_silent":
             return gold[len(run)][0] if len(gold) > len(run) else None
         return next((a[0] for a, b in zip(run, gold, strict=False) if a != b), None)

@@ -50,8 +50,8 @@ def degraded_at_end(ctx: Context) -> list[str]:
             if e.get("text", "").startswith("membership ") and "(lost " in e["text"]:
                 out.append(f"{node}: {e['text']}")
                 break
-    last = {k: d for _t, k, d in ctx.run.fcs_status}
-    gold_last = {k: d for _t, k, d in ctx.golden.fcs_status} if ctx.golden else {}
+    last = _last_status(ctx.run)
+    gold_last = _last_status(ctx.golden) if ctx.golden else {}
     for k, d in last.items():
         g = gold_last.get(k, {})
         if d.get("FCS_FALLBACK") != g.get("FCS_FALLBACK") or d.get("FCS_MODE") != g.get("FCS_MODE"):
@@ -118,6 +118,15 @@ def confirmation(ctx: Context, conf: list[Confirmation]) -> dict:
     return {"verdict": "unconfirmed" if allowed else "fail", "unconfirmed": text}
 
 
+def _last_status(traces: RunTraces) -> dict[int, dict]:
+    """Each channel's last FCS_MODE and FCS_FALLBACK."""
+    out: dict[int, dict] = {}
+    for field in ("FCS_MODE", "FCS_FALLBACK"):
+        for k, (_times, values) in traces.fcs_field(field).items():
+            out.setdefault(k, {})[field] = values[-1]
+    return out
+
+
 _GOLDEN: dict = {}  # the last golden run read by this process: a campaign's runs share them
 
 
@@ -136,9 +145,11 @@ def golden_traces(golden_dir: Path) -> RunTraces:
     return _GOLDEN[key]
 
 
-def judge(run_dir: Path, golden_dir: Path | None, plan: Plan, system, duration_s: float) -> dict:
-    """The `faults`, `oracles` and `outcome` of a run's summary."""
-    ctx = Context(run=RunTraces(run_dir), golden=golden_traces(golden_dir) if golden_dir
+def judge(run_dir: Path, golden_dir: Path | None, plan: Plan, system, duration_s: float,
+          run: RunTraces | None = None) -> dict:
+    """The `faults`, `oracles` and `outcome` of a run's summary (`run`: the run's records when
+    the caller has read some already)."""
+    ctx = Context(run=run or RunTraces(run_dir), golden=golden_traces(golden_dir) if golden_dir
                   else None, plan=plan, system=system, duration_s=duration_s)
     conf = [check(ctx, inj) for inj in plan.injections]
     verdicts = {"confirmation": confirmation(ctx, conf)}

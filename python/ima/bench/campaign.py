@@ -11,6 +11,9 @@ and for 300 s, at -j 1 and at -j 2 (one flight per CPU, each pinned to its own):
 - runner_overhead: at -j 1, the wall time of the runs over the wall time of their flights, less
   one: what the runner adds (starting each job, judging it against its golden run, writing its
   record) to the flights it runs;
+- reflown: flights flown again because the host stalled a partition that was not a target
+  (their time counts in the flights');
+- violations: run -> the oracles it violated (none expected);
 - peak_rss_mb: the peak of the summed resident memory of every process of the benchmark (the
   runner, its workers and their flights).
 """
@@ -83,7 +86,8 @@ def measure(duration_s: float, runs: int, jobs: int, folder: Path) -> dict:
     records = runner.run(c, runner.RunnerOptions(out=out, jobs=jobs), clock)
     runs_wall = clock.last - clock.goldens_done
     flights = sum(r["flight_wall_s"] for r in records)
-    bad = [r["run_id"] for r in records if r["measures"]["oracle_violations"]]
+    bad = {r["run_id"]: r["measures"]["oracle_violations"] for r in records
+           if r["measures"]["oracle_violations"]}
     return {"runs": len(records), "jobs": jobs, "duration_s": duration_s,
             "golden_wall_s": round(clock.goldens_done - clock.t0, 2),
             "runs_wall_s": round(runs_wall, 2),
@@ -91,10 +95,11 @@ def measure(duration_s: float, runs: int, jobs: int, folder: Path) -> dict:
             "flight_wall_s_median": round(statistics.median(r["flight_wall_s"]
                                                             for r in records), 2),
             "runner_overhead": round(runs_wall * jobs / flights - 1, 3) if flights else None,
+            "reflown": sum(r.get("refly", 0) for r in records),
             "violations": bad}
 
 
-def run(json_out: bool, runs_60: int = 8, runs_300: int = 4) -> int:
+def run(json_out: bool, runs_60: int = 8, runs_300: int = 6) -> int:
     from rich.console import Console
 
     from ima.bench.flight import RssSampler

@@ -6,7 +6,7 @@ turned into one FARM record (Fault, Activation, Readouts, Measures)."""
 
 from __future__ import annotations
 
-import json
+import functools
 import shutil
 import time
 from pathlib import Path
@@ -37,20 +37,30 @@ def options(campaign: dict, run: dict, run_dir: Path, faults: list) -> LaunchOpt
             campaign.get("test_switches") or []))
 
 
-def host_stalls(run_dir: Path, targets: set[tuple[str, str]]) -> list[dict]:
+def host_stalls(traces, targets: set[tuple[str, str]]) -> list[dict]:
     """CPU-budget overruns of partitions that are not targets of a fault: the RPAS partitions
     use a tiny part of their budgets, so one that overran was stalled by the host (a preempted
     virtual CPU, direct reclaim), not by anything under test."""
-    out = []
-    for trace in sorted(run_dir.glob("node*.jsonl")):
-        node = trace.stem
-        with open(trace, encoding="utf-8") as f:
-            for line in f:
-                if '"kind":"overrun"' in line and '"cause":"cpu_budget"' in line:
-                    e = json.loads(line)
-                    if (node, e.get("partition")) not in targets and (node, None) not in targets:
-                        out.append(dict(e, node=node))
-    return out
+    return [dict(e, node=node) for node in traces.nodes
+            for e in traces.node_kind(node, "overrun")
+            if e.get("cause") == "cpu_budget" and (node, e.get("partition")) not in targets
+            and (node, None) not in targets]
+
+
+@functools.lru_cache(maxsize=4)
+def _system(path: str, mtime_ns: int):
+    from ima.deploy import load_system
+
+    return load_system(Path(path))
+
+
+def system_of(path: Path):
+    """The system model, read once per worker (again if the file changed)."""
+    try:
+        stamp = path.stat().st_mtime_ns
+    except OSError:
+        stamp = -1  # load_system says what is wrong with it
+    return _system(str(path), stamp)
 
 
 def run_one(campaign: dict, run: dict, run_dir: Path | None = None) -> dict:
@@ -59,8 +69,8 @@ def run_one(campaign: dict, run: dict, run_dir: Path | None = None) -> dict:
     from faultinject import grammar
     from faultinject.judge import judge
     from faultinject.oracles import direct_targets
+    from faultinject.traces import RunTraces
     from ima import provenance
-    from ima.deploy import load_system
     from ima.launch import run as launch_run
 
     t0 = time.monotonic()
@@ -74,7 +84,7 @@ def run_one(campaign: dict, run: dict, run_dir: Path | None = None) -> dict:
         shutil.rmtree(run_dir, ignore_errors=True)
         opts = options(campaign, run, run_dir, faults)
         try:
-            result = launch_run.launch(opts)
+            result = launch_run.launch(opts, system=system_of(Path(opts.system)))
         except ImaError as exc:
             # A run that could not be flown (a condition that never came, a process that
             # would not start) is a failed run of the campaign, not the campaign's end.
@@ -84,14 +94,15 @@ def run_one(campaign: dict, run: dict, run_dir: Path | None = None) -> dict:
             raise KeyboardInterrupt(f"{run['run_id']} interrupted")
         targets = {t for inj in result.plan.injections for t in direct_targets(inj)} \
             if result.plan else set()
-        stalls = host_stalls(run_dir, targets)
+        traces = RunTraces(run_dir)  # read once: the stalls, the judgement, the HM
+        stalls = host_stalls(traces, targets)
         if not stalls or refly >= 2:
             break
         refly += 1
-    system = load_system(Path(opts.system))
+    system = system_of(Path(opts.system))
     failed = {k: v for k, v in result.returncodes.items()
               if v not in (0, None) and k.split("/")[0] not in {**result.killed, **result.hung}}
-    j = judge(run_dir, golden, result.plan, system, campaign["duration_s"])
+    j = judge(run_dir, golden, result.plan, system, campaign["duration_s"], run=traces)
     measures = {"outcome": j["outcome"],
                 "oracles": {k: v.get("verdict") for k, v in j["oracles"].items()},
                 "oracle_violations": j["oracle_violations"], "known_limit": j["known_limit"]}
@@ -114,7 +125,7 @@ def run_one(campaign: dict, run: dict, run_dir: Path | None = None) -> dict:
                      "degraded": j["degraded"], "truth_identical": j["truth_identical"],
                      "hm": [{k: e.get(k) for k in ("t_ns", "partition", "error", "level",
                                                     "action")}
-                            for n in result.nodes for e in _hm(run_dir, n)][:20]},
+                            for n in result.nodes for e in traces.node_kind(n, "hm")][:20]},
         "measures": measures,
         "oracles": j["oracles"],
         "refly": refly, "wall_s": round(time.monotonic() - t0, 2),
@@ -155,18 +166,6 @@ def _unflown(campaign: dict, run: dict, run_dir: Path, faults: list, exc: Except
         "provenance": provenance.provenance(campaign.get("argv")),
         "run_dir": str(run_dir),
     }
-
-
-def _hm(run_dir: Path, node: str) -> list[dict]:
-    out = []
-    try:
-        with open(run_dir / f"{node}.jsonl", encoding="utf-8") as f:
-            for line in f:
-                if '"kind":"hm"' in line:
-                    out.append(json.loads(line))
-    except OSError:
-        pass
-    return out
 
 
 def deterministic(record: dict) -> dict:

@@ -45,8 +45,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     camp.add_argument("--json", action="store_true", help="print the results as JSON")
     camp.add_argument("--runs-60", type=positive_int, default=8, metavar="N",
                       help="runs of 60 s flights per measurement (default 8)")
-    camp.add_argument("--runs-300", type=positive_int, default=4, metavar="N",
-                      help="runs of 300 s flights per measurement (default 4)")
+    camp.add_argument("--runs-300", type=positive_int, default=6, metavar="N",
+                      help="runs of 300 s flights per measurement (default 6)")
     cmp_ = targets.add_parser(
         "compare", help="a benchmark of this checkout against another checkout (the previous "
         "main), alternating, pinned to one CPU; per-pair ratios and their median")

@@ -47,9 +47,10 @@ _READY_TIMEOUT_S = 60.0
 
 
 def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None,
-           stop_when: Callable[[dict], bool] | None = None) -> LaunchRun:
+           stop_when: Callable[[dict], bool] | None = None, system=None) -> LaunchRun:
     """Runs the system to its end (or Ctrl-C, or the first status line `stop_when` accepts);
-    the caller summarises the run directory."""
+    the caller summarises the run directory. `system`: opts.system already loaded (a
+    campaign's worker reads it once)."""
     from ima import dds
     from ima.deploy import generate, load_system
     from imaworld import pilot as pilot_script
@@ -58,7 +59,8 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None,
         raise ImaError(f"--turbulence must be one of {', '.join(TURBULENCE)}")
     if not opts.duration_s > 0:
         raise ImaError("--duration must be positive")
-    system = load_system(Path(opts.system))
+    if system is None:
+        system = load_system(Path(opts.system))
     names = [n.name for n in system.nodes]
     if opts.netns and os.geteuid() != 0:
         raise ImaError("--netns needs root (it creates network namespaces)")

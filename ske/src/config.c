@@ -139,6 +139,9 @@ static void load_partition(ske_loader_t *L, const xmlNode *n)
             }
             have_linux = true;
             ske__attr(c, "Executable", p->exe_name, sizeof p->exe_name);
+            ske__attr(c, "OutputFile", p->output_file, sizeof p->output_file);
+            ske__attr(c, "HealthMonitorLogPort", p->hm_log_port_name,
+                      sizeof p->hm_log_port_name);
             char args[2048];
             split_args(L, c, p, ske__attr(c, "Arguments", args, sizeof args) ? args : NULL);
         }
@@ -163,6 +166,37 @@ static void load_memory(ske_loader_t *L, const xmlNode *n)
         if (ske__attr_u64(L, c, "SizeBytes", &sz, (uint64_t)1 << 40, true))
             p->memory_bytes += sz;
     }
+}
+
+/* ima:Linux HealthMonitorLogPort names one of the partition's own destination queuing
+ * ports, connected to no channel (the SKE is its source), large enough for a decision. */
+static void check_hm_log_port(ske_loader_t *L, ske_partition_cfg_t *p)
+{
+    p->hm_log_port = -1;
+    if (!p->hm_log_port_name[0])
+        return;
+    const char *rule = "the health-monitor log port is one of the partition's destination "
+                       "queuing ports, on no channel, of at least the size of a decision";
+    for (int k = 0; k < p->n_ports; k++) {
+        const ske_port_cfg_t *pc = &p->ports[k];
+        if (strcmp(pc->name, p->hm_log_port_name) != 0)
+            continue;
+        if (pc->kind != SKE_PORT_QUEUING || pc->dir != SKE_DIR_DESTINATION || pc->channel >= 0 ||
+            pc->max_size < sizeof(ske_hm_log_t)) {
+            ske__diag_set(L->diag, L->m->path, pc->line, "Queuing_Port", rule,
+                          "partition '%s': HealthMonitorLogPort '%s' must be a destination "
+                          "queuing port on no channel with MaxMessageSize of at least %zu",
+                          p->name, pc->name, sizeof(ske_hm_log_t));
+            L->failed = true;
+            return;
+        }
+        p->hm_log_port = k;
+        return;
+    }
+    ske__diag_set(L->diag, L->m->path, p->line, "Partition", rule,
+                  "partition '%s': HealthMonitorLogPort '%s' is not one of its ports", p->name,
+                  p->hm_log_port_name);
+    L->failed = true;
 }
 
 /* Bare names are looked up in the partition path; names with a slash are relative to the
@@ -248,6 +282,8 @@ static void load_module(ske_loader_t *L, xmlNode *root)
             if (ske__is_elem(ch, "Channel", false))
                 ske__load_channel(L, ch);
     }
+    for (int i = 0; i < m->n_partitions && !L->failed; i++)
+        check_hm_log_port(L, &m->partitions[i]);
     if (L->failed || !(L->opts && L->opts->resolve_executables))
         return;
     for (int i = 0; i < m->n_partitions && !L->failed; i++)

@@ -38,6 +38,7 @@ void ske__trace_hm_fields(ske_t *s, int64_t t, const ske_part_t *p, hm_error_t e
         ske_trace_strn(&s->trace, "message", message, mlen);
     if (note)
         ske_trace_str(&s->trace, "note", note);
+    ske__hm_log_publish(s, t, p, err, level, action, state, process, pname, message, mlen);
 }
 
 static void trace_hm(ske_t *s, int64_t t, const ske_part_t *p, hm_error_t err, hm_level_t level,

@@ -45,6 +45,8 @@ static void usage(FILE *f)
           "                        [,period=TIME,on=TIME],partition=NAME[,process=NAME][,port=NAME]\n"
           "                        [,value=X], or module_reset:fid=ID,at=TIME (docs/trace-format.md)\n"
           "  --trace-port-hashes   trace a port_hash event per source port written in a window\n"
+          "  --output-dir DIR      folder of the partitions' relative output files (ima:Linux\n"
+          "                        OutputFile; default: the module file's folder)\n"
           "  --test-switch NAME[=VALUE]  test only: break an isolation guarantee on purpose\n"
           "                        (overrun-eats-next-window, hm-action=PARTITION:ACTION,\n"
           "                        corrupt-port=PARTITION.PORT@TIME)\n"
@@ -68,7 +70,7 @@ static int parse_frames(const char *s, int64_t *out)
 int main(int argc, char **argv)
 {
     enum { O_FRAMES = 1000, O_REALTIME, O_EMULATED, O_TRACE, O_STATS, O_NODE, O_SCHEMA, O_PPATH, O_CHECK, O_LOCKSTEP, O_NODE_INDEX,
-           O_FAULT, O_PORT_HASHES, O_TEST_SWITCH };
+           O_FAULT, O_PORT_HASHES, O_TEST_SWITCH, O_OUTPUT_DIR };
     static const struct option longopts[] = {
         {"frames", required_argument, NULL, O_FRAMES},
         {"realtime", no_argument, NULL, O_REALTIME},
@@ -84,6 +86,7 @@ int main(int argc, char **argv)
         {"fault", required_argument, NULL, O_FAULT},
         {"trace-port-hashes", no_argument, NULL, O_PORT_HASHES},
         {"test-switch", required_argument, NULL, O_TEST_SWITCH},
+        {"output-dir", required_argument, NULL, O_OUTPUT_DIR},
         {"quiet", no_argument, NULL, 'q'},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0},
@@ -126,6 +129,7 @@ int main(int argc, char **argv)
         }
         case O_FAULT: faults[ro.n_faults++] = optarg; break;
         case O_PORT_HASHES: ro.trace_port_hashes = true; break;
+        case O_OUTPUT_DIR: ro.output_dir = optarg; break;
         case O_TEST_SWITCH: switches[ro.n_test_switches++] = optarg; break;
         case O_SCHEMA: lo.schema_dir = optarg; break;
         case O_PPATH: lo.partition_path = optarg; break;

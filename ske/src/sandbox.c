@@ -27,7 +27,7 @@ static int limit(int resource, rlim_t value)
     return setrlimit(resource, &r) == 0 ? 0 : -errno;
 }
 
-int ske__sandbox_enter(const ske_partition_cfg_t *cfg, int ctl_fd, int n_ports)
+int ske__sandbox_enter(const ske_partition_cfg_t *cfg, int ctl_fd, int n_ports, int output_fd)
 {
     /* Partition_Memory bounds the partition's data: heap, process stacks, static data of the
      * program and its libraries (RLIMIT_DATA counts private writable mappings and the heap).
@@ -50,6 +50,7 @@ int ske__sandbox_enter(const ske_partition_cfg_t *cfg, int ctl_fd, int n_ports)
         .self = (int32_t)getpid(),
         .shared_fd_lo = ctl_fd,
         .shared_fd_hi = ctl_fd + 1 + n_ports,
+        .output_fd = output_fd,
     };
     if (rc == 0)
         rc = ske_sandbox_build(&pol, SKE_SANDBOX_LOAD, &prog);

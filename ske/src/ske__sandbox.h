@@ -20,7 +20,7 @@ uint32_t ske__sandbox_flags(const ske_partition_cfg_t *cfg);
  * (control block at ctl_fd, its n_ports ports right above): sets its resource limits (data
  * from Partition_Memory, stack), then installs the LOAD filter. Returns 0 or -errno;
  * allocates nothing. */
-int ske__sandbox_enter(const ske_partition_cfg_t *cfg, int ctl_fd, int n_ports);
+int ske__sandbox_enter(const ske_partition_cfg_t *cfg, int ctl_fd, int n_ports, int output_fd);
 
 /* Once the partition has attached, before its first grant: SKE_OK if it runs under its own
  * filter on top of the LOAD filter, else SKE_E_PARTITION with a one-line message. */

@@ -62,6 +62,8 @@ typedef struct {
     uint64_t overruns;
     uint64_t restarts;
     bool exit_to_judge; /* ended on its own: the health monitor has yet to decide */
+    int output_fd; /* its output file, opened by the SKE (output.c); -1: none */
+    uint64_t hm_log_lost; /* HM decisions its full health-monitor log port could not take */
 } ske_part_t;
 
 /* The emulator: every file of the supervisor is passed it, none keeps state of its own. */
@@ -128,6 +130,13 @@ int ske__memobj(const char *name, size_t size, void **mem);
 /* Every port's memory object; a sampling channel's destinations share their source's. */
 int ske__setup_ports(ske_t *s, char *err, size_t errlen);
 void ske__free_ports(ske_part_t *p);
+
+/* output.c: partitions' output files, and the module's health-monitor log. */
+int ske__open_outputs(ske_t *s, char *err, size_t errlen);
+void ske__close_outputs(ske_t *s);
+void ske__hm_log_publish(ske_t *s, int64_t t, const ske_part_t *about, hm_error_t err,
+                         hm_level_t level, hm_action_t action, hm_state_t state, int32_t process,
+                         const char *pname, const char *message, size_t mlen);
 
 /* ---- hm_actions.c: health-monitor decisions applied ----------------------------------- */
 

@@ -54,6 +54,9 @@ static void fill_ctl(ske_t *s, ske_part_t *p)
     c->time_mode = s->time_mode;
     c->system_partition = p->cfg->system_partition;
     c->sandbox_flags = ske__sandbox_flags(p->cfg);
+    /* The child's descriptor numbers: 3 the control block, 4.. its ports, then the exec-error
+     * pipe, then its output file. */
+    c->output_fd = p->output_fd >= 0 ? 5 + p->cfg->n_ports : -1;
     c->epoch_mono_ns = s->epoch_mono_ns;
     c->period_ns = p->cfg->period_ns;
     c->duration_ns = p->cfg->duration_ns;
@@ -152,16 +155,22 @@ static void child_exec(ske_t *s, ske_part_t *p, int errpipe, char **envp)
         high[1 + k] = fcntl(src, F_DUPFD, base);
     }
     high[1 + n] = fcntl(errpipe, F_DUPFD_CLOEXEC, base);
+    int out_high = p->output_fd >= 0 ? fcntl(p->output_fd, F_DUPFD, base) : -1;
     for (int k = 0; k <= n; k++)
         dup2(high[k], 3 + k);
     dup2(high[1 + n], 4 + n);
     fcntl(4 + n, F_SETFD, FD_CLOEXEC);
-    close_range(5 + (unsigned)n, ~0U, 0);
+    int last = 4 + n;
+    if (out_high >= 0) {
+        dup2(out_high, 5 + n); /* its output file, kept across the exec */
+        last = 5 + n;
+    }
+    close_range((unsigned)last + 1, ~0U, 0);
     if (getppid() != s->pid)
         _exit(127); /* the SKE is already gone */
     /* Last before the exec: the memory limit and the loader's system-call filter. A failure
      * goes to the SKE as a negative number, told apart from an exec error. */
-    int confined = ske__sandbox_enter(p->cfg, 3, n);
+    int confined = ske__sandbox_enter(p->cfg, 3, n, out_high >= 0 ? 5 + n : -1);
     if (confined != 0) {
         ssize_t wc = write(4 + n, &confined, sizeof confined);
         (void)wc;
@@ -174,19 +183,26 @@ static void child_exec(ske_t *s, ske_part_t *p, int errpipe, char **envp)
     _exit(127);
 }
 
-static char **make_env(void)
+/* The SKE's environment with the partition's descriptors; out holds the output file's
+ * variable (it lives as long as the caller's buffer). */
+static char **make_env(const ske_part_t *p, char *out, size_t outlen)
 {
     size_t n = 0;
     while (environ[n])
         n++;
-    char **envp = calloc(n + 2, sizeof *envp);
+    char **envp = calloc(n + 3, sizeof *envp);
     if (!envp)
         return NULL;
     size_t j = 0;
     for (size_t i = 0; i < n; i++)
-        if (strncmp(environ[i], SKE_ENV_CTL_FD "=", strlen(SKE_ENV_CTL_FD) + 1) != 0)
+        if (strncmp(environ[i], SKE_ENV_CTL_FD "=", strlen(SKE_ENV_CTL_FD) + 1) != 0 &&
+            strncmp(environ[i], SKE_ENV_OUTPUT_FD "=", strlen(SKE_ENV_OUTPUT_FD) + 1) != 0)
             envp[j++] = environ[i];
     envp[j++] = SKE_ENV_CTL_FD "=3";
+    if (p->output_fd >= 0) {
+        snprintf(out, outlen, SKE_ENV_OUTPUT_FD "=%d", 5 + p->cfg->n_ports);
+        envp[j++] = out;
+    }
     envp[j] = NULL;
     return envp;
 }
@@ -195,7 +211,8 @@ int ske__spawn(ske_t *s, ske_part_t *p, char *err, size_t errlen)
 {
     fill_ctl(s, p);
     p->ended = false; /* a new process: the last one's end no longer describes the partition */
-    char **envp = make_env();
+    char outvar[64];
+    char **envp = make_env(p, outvar, sizeof outvar);
     int pipefd[2];
     if (!envp || pipe2(pipefd, O_CLOEXEC) != 0) {
         free(envp);

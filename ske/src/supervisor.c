@@ -75,12 +75,15 @@ int ske_create(const ske_module_cfg_t *cfg, const ske_run_opts_t *opts, ske_t **
         p->index = i;
         p->state = SKE_PS_NOT_STARTED;
         p->ctl_fd = -1;
+        p->output_fd = -1;
         p->start_condition = 0; /* NORMAL_START */
         p->initial_mode = SKE_MODE_COLD_START;
         for (int k = 0; k < SKE_MAX_PORTS; k++)
             p->ports[k].fd = p->ports[k].fd_ro = -1;
     }
     rc = ske__setup_ports(s, err, errlen);
+    if (rc == SKE_OK)
+        rc = ske__open_outputs(s, err, errlen);
     if (rc != SKE_OK)
         goto fail;
     for (int i = 0; i < cfg->n_partitions; i++) {
@@ -253,6 +256,7 @@ void ske_destroy(ske_t *s)
         if (p->ctl_fd >= 0)
             close(p->ctl_fd);
     }
+    ske__close_outputs(s);
     ske_trace_close(&s->trace);
     ske_samples_free(&s->switch_ns);
     ske_samples_free(&s->jitter_ns);

@@ -259,8 +259,24 @@ class _Builder:
                 memory=[Memory(m["size"], m.get("type"), m.get("access"))
                         for m in p.get("memory") or []],
                 hm=self.hm_table(p.get("health_monitoring") or {}),
+                output_file=p.get("output_file"),
+                hm_log_port=self.hm_log_port(at, p),
             ))
         return out
+
+    def hm_log_port(self, at: tuple, p: dict) -> str | None:
+        """The port that receives the module's HM decisions: a destination queuing port of
+        the partition, large enough for one (ske_hm_log_t), on no channel."""
+        name = p.get("hm_log_port")
+        if name is None:
+            return None
+        port = next((q for q in p["ports"] if q["name"] == name), None)
+        if port is None or port["kind"] != "queuing" or port["direction"] != "destination" \
+                or port["size"] < HM_LOG_SIZE:
+            raise self.fail(at + ("hm_log_port",),
+                            f"'{name}' must be one of {p['name']}'s destination queuing ports, "
+                            f"of at least {HM_LOG_SIZE} bytes (one health-monitor decision)")
+        return name
 
     def arguments(self, at: tuple, words: list[str]) -> list[str]:
         """Arguments whose {names} are all ARGUMENT_FIELDS (filled in per node on deploy)."""
@@ -581,6 +597,10 @@ class _Builder:
                                 f"no message {msg} ({node.name}'s heartbeat on channel "
                                 f"{node.channel}) in {can['dbc'].name}")
         return {"heartbeat": m["heartbeat"], "missed_frames": m["missed_frames"]}
+
+
+# sizeof(ske_hm_log_t) (ske/abi/include/ske_abi.h): one decision of the module's HM log.
+HM_LOG_SIZE = 232
 
 
 @functools.lru_cache(maxsize=8)

@@ -145,6 +145,9 @@ class Partition:
     memory: list[Memory]
     # Partition_HM_Table: state -> error identifier -> action.
     hm: dict[int, dict[int, str]] = field(default_factory=dict)
+    # ima:Linux OutputFile ({node} filled in per node) and HealthMonitorLogPort.
+    output_file: str | None = None
+    hm_log_port: str | None = None
 
     def port(self, name: str) -> Port | None:
         return next((p for p in self.ports if p.name == name), None)

@@ -91,7 +91,10 @@ def _partition(system: System, node: Node, p: Partition, extra: list[str]) -> li
         lines += _tag(4, "Process", [("Name", pr.name), ("StackSize", pr.stack)])
     words = system.arguments(p, node) + extra
     args = " ".join(words) if words else None
-    lines += _tag(4, "ima:Linux", [("Executable", p.executable), ("Arguments", args)])
+    output = p.output_file.replace("{node}", node.name) if p.output_file else None
+    lines += _tag(4, "ima:Linux", [("Executable", p.executable), ("Arguments", args),
+                                   ("OutputFile", output),
+                                   ("HealthMonitorLogPort", p.hm_log_port)])
     lines.append("  </Partition>")
     return lines
 

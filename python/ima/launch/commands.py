@@ -94,6 +94,7 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
             str(paths.ske_binary()), "--lockstep", str(sock), "--node", node,
             "--node-index", str(k), "--partition-path", partition_path(opts.partition_path),
             "--trace", str(run_dir / f"{node}.jsonl"), "--stats", str(run_dir / f"{node}.json"),
+            "--output-dir", str(run_dir),  # the partitions' output files (the recordings)
             "-q", *(["--trace-port-hashes"] if opts.port_hashes else []),
             *faults.ske.get(node, []), *switches.get(node, []), "--", str(modules[node])]
     return out

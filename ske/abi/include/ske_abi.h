@@ -11,7 +11,7 @@
 #include <time.h>
 
 #define SKE_ABI_MAGIC 0x53414d49u /* "IMAS" */
-#define SKE_ABI_VERSION 5u
+#define SKE_ABI_VERSION 6u
 
 #define SKE_NAME_MAX 32 /* names carry at most 31 characters + NUL (ARINC allows 30) */
 #define SKE_MAX_PORTS 64 /* per partition */
@@ -28,6 +28,9 @@
 
 /* Environment variable naming the control block's file descriptor in a partition. */
 #define SKE_ENV_CTL_FD "IMA_SKE_CTL_FD"
+/* Environment variable naming the descriptor of the partition's output file (ima:Linux
+ * OutputFile), which the SKE opened for it: the only file it may write. */
+#define SKE_ENV_OUTPUT_FD "IMA_OUTPUT_FD"
 
 typedef enum {
     SKE_TIME_EMULATED = 0,
@@ -122,6 +125,25 @@ typedef struct {
     char fid[SKE_FAULT_ID_MAX];
 } ske_fault_slot_t;
 
+/* One health-monitor decision of the module, as the SKE writes it into the destination
+ * queuing port a partition names as its module's health-monitor log (ima:Linux
+ * HealthMonitorLogPort): every decision taken at partition or module level, whichever
+ * partition it is about. */
+typedef struct {
+    int64_t t_ns; /* module time of the decision */
+    char partition[SKE_NAME_MAX]; /* the partition the error is about */
+    char process[SKE_NAME_MAX]; /* the failed process, "" for none */
+    uint32_t error; /* hm_error_t */
+    uint32_t level; /* hm_level_t */
+    uint32_t action; /* hm_action_t */
+    uint32_t state; /* hm_state_t */
+    int32_t process_id;
+    int32_t error_code; /* APEX ERROR_CODE_TYPE */
+    uint32_t len; /* bytes used in message */
+    char message[SKE_EVENT_TEXT];
+    uint32_t pad;
+} ske_hm_log_t;
+
 /* One of the partition's own ports. The SKE fills it before exec; `fd` is the partition's
  * descriptor of the port memory (read-only for destination ports). */
 typedef struct {
@@ -163,6 +185,8 @@ typedef struct {
     uint32_t initial_mode; /* COLD_START or WARM_START */
     uint32_t n_ports;
     uint32_t sandbox_flags; /* SKE_SANDBOX_*: what the partition's system-call filter allows */
+    int32_t output_fd; /* its output file's descriptor (ima:Linux OutputFile), -1: none */
+    uint32_t pad_output;
     ske_port_desc_t ports[SKE_MAX_PORTS];
 
     /* Hand-over. */

@@ -40,6 +40,9 @@ typedef struct {
      * closed them: a file a system partition opens is I/O, never shared memory). */
     int32_t shared_fd_lo;
     int32_t shared_fd_hi;
+    /* Its output file (ima:Linux OutputFile), which the SKE opened for it: besides standard
+     * output and error, the one descriptor it may write and sync. Below 3: none. */
+    int32_t output_fd;
 } ske_sandbox_policy_t;
 
 #define SKE_SANDBOX_PROG_MAX 1024

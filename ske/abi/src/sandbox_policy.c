@@ -229,7 +229,9 @@ static void common_calls(prog_t *p, const ske_sandbox_policy_t *pol, bool io, bo
     const cond_t self1 = in1(1, (uint32_t)pol->self);
     /* Standard output and error only, once running; before, the loader and ima-ske's child
      * may also write to their own descriptors (an exec error to ima-ske). */
-    const cond_t stdio = {0, C_IN, 2, {STDOUT_FILENO, STDERR_FILENO}};
+    cond_t stdio = {0, C_IN, 2, {STDOUT_FILENO, STDERR_FILENO}};
+    if (pol->output_fd > STDERR_FILENO)
+        stdio.v[stdio.n++] = (uint32_t)pol->output_fd; /* and its output file */
     const cond_t *out_fd = io || load ? NULL : &stdio;
 
     allow(p, SYS_futex);
@@ -242,6 +244,12 @@ static void common_calls(prog_t *p, const ske_sandbox_policy_t *pol, bool io, bo
     } else {
         allow(p, SYS_write);
         allow(p, SYS_writev);
+    }
+    if (!io && pol->output_fd > STDERR_FILENO) {
+        /* Its output file: made durable, never anything else */
+        const cond_t output = in1(0, (uint32_t)pol->output_fd);
+        rule(p, SYS_fdatasync, &output, NULL);
+        rule(p, SYS_fsync, &output, NULL);
     }
     rule_mmap(p, SYS_mmap, pol);
     allow(p, SYS_mprotect);

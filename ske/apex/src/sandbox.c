@@ -11,7 +11,8 @@ int apex__sandbox_install(const ske_ctl_t *ctl)
 {
     /* Its control block and ports are mapped and their descriptors closed by now: from here
      * on it may map no file shared. */
-    ske_sandbox_policy_t pol = {.flags = ctl->sandbox_flags, .self = (int32_t)getpid()};
+    ske_sandbox_policy_t pol = {.flags = ctl->sandbox_flags, .self = (int32_t)getpid(),
+                                .output_fd = ctl->output_fd};
     ske_sandbox_prog_t prog;
     int rc = ske_sandbox_build(&pol, SKE_SANDBOX_RUN, &prog);
     if (rc == 0)

@@ -66,6 +66,14 @@ typedef struct {
     char exe_name[SKE_PATH_MAX]; /* as written in the module */
     int argc;
     char *argv[SKE_MAX_ARGS]; /* argv[0] is the partition name */
+    /* Its output file (ima:Linux OutputFile): opened by the SKE, handed to the partition as
+     * the one file it may write; "" for none. As written; resolved against the SKE's output
+     * folder (--output-dir, default the module file's folder) when the SKE opens it. */
+    char output_file[SKE_PATH_MAX];
+    /* ima:Linux HealthMonitorLogPort: the destination queuing port that receives the
+     * module's health-monitor decisions (ske_hm_log_t); index in ports, -1 for none. */
+    int hm_log_port;
+    char hm_log_port_name[SKE_NAME_MAX];
     /* schedule: period_ns is the same in every module schedule; duration and anchor are the
      * initial schedule's, with each schedule's own in the _in arrays */
     int64_t period_ns;

@@ -28,6 +28,8 @@ typedef struct {
     const char *const *test_switches;
     int n_test_switches;
     bool trace_port_hashes; /* a port_hash event per source port written in a window */
+    /* Folder of relative output files (ima:Linux OutputFile); NULL: the module file's. */
+    const char *output_dir;
 } ske_run_opts_t;
 
 /* Checks the faults and test switches of opts against the module: SKE_OK, or SKE_E_CONFIG

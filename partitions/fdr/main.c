@@ -41,7 +41,7 @@ static bool read_sampling(int p, void *msg)
     RETURN_CODE_TYPE rc;
     READ_SAMPLING_MESSAGE((SAMPLING_PORT_ID_TYPE)app.ids[p], (MESSAGE_ADDR_TYPE)buf, &len, &v,
                           &rc);
-    if (rc != NO_ERROR || len != fdr_port_spec[p].size || len > sizeof buf)
+    if (rc != NO_ERROR || len != fdr_port_spec[p].size || len < 0 || (size_t)len > sizeof buf)
         return false;
     memcpy(msg, buf, (size_t)len);
     return v == VALID;
@@ -91,7 +91,7 @@ static void cycle(void)
                                     (MESSAGE_ADDR_TYPE)&hm, &len, &rc);
             if (rc != NO_ERROR && rc != INVALID_CONFIG) /* INVALID_CONFIG: some were lost */
                 break;
-            if (len != sizeof hm)
+            if (len != (MESSAGE_SIZE_TYPE)sizeof hm)
                 continue;
             fdr_hm_record(&app.rec, now, &hm, app.buf + n);
             n += FDR_RECORD_SIZE;

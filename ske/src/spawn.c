@@ -44,6 +44,10 @@ bool ske__alive(const ske_part_t *p)
 static void fill_ctl(ske_t *s, ske_part_t *p)
 {
     ske_ctl_t *c = p->ctl;
+    /* The module's HM log keeps what the partition had not read when its last process
+     * ended (its own end among it): a restarted recorder records it. */
+    int hm_k = p->cfg->hm_log_port;
+    uint32_t hm_tail = hm_k >= 0 ? atomic_load(&c->ports[hm_k].rx_tail) : 0;
     memset(c, 0, sizeof *c);
     c->magic = SKE_ABI_MAGIC;
     c->version = SKE_ABI_VERSION;
@@ -78,11 +82,12 @@ static void fill_ctl(ske_t *s, ske_part_t *p)
         d->map_size = (uint32_t)p->ports[k].size;
         d->channel = pc->channel >= 0 ? (uint32_t)s->cfg->channels[pc->channel].id : 0;
         /* A (re)started partition finds its destination queues empty (its ports are
-         * created anew), whatever the queue memory still holds from before. */
+         * created anew), whatever the queue memory still holds from before; but for the
+         * module's HM log, which it finds as its last process left it. */
         uint32_t head = 0, overflows = 0;
         if (pc->kind == SKE_PORT_QUEUING && pc->dir == SKE_DIR_DESTINATION && p->ports[k].mem) {
             const ske_queue_hdr_t *q = p->ports[k].mem;
-            head = atomic_load(&q->head);
+            head = k == hm_k ? hm_tail : atomic_load(&q->head);
             overflows = atomic_load(&q->overflows);
         }
         atomic_store(&d->rx_tail, head);

@@ -71,9 +71,9 @@ static void build(progs_t *p, uint32_t flags)
 {
     /* As ima-ske and the APEX library build them: the descriptors ima-ske passes may be
      * mapped shared while the APEX maps them; once it runs, they are closed. */
-    ske_sandbox_policy_t load = {flags, SELF, CTL_FD, PORT_HI};
+    ske_sandbox_policy_t load = {flags, SELF, CTL_FD, PORT_HI, -1};
     CHECK_EQ(ske_sandbox_build(&load, SKE_SANDBOX_LOAD, &p->load), 0);
-    ske_sandbox_policy_t running = {flags, SELF, 0, 0};
+    ske_sandbox_policy_t running = {flags, SELF, 0, 0, -1};
     CHECK_EQ(ske_sandbox_build(&running, SKE_SANDBOX_RUN, &p->run), 0);
     CHECK(p->load.len > 0 && p->run.len > 0);
 }
@@ -238,7 +238,7 @@ static void test_system_partition(void)
 static void test_no_ports(void)
 {
     /* A partition without ports maps only its control block shared. */
-    ske_sandbox_policy_t pol = {0, SELF, CTL_FD, CTL_FD + 1};
+    ske_sandbox_policy_t pol = {0, SELF, CTL_FD, CTL_FD + 1, -1};
     ske_sandbox_prog_t prog;
     CHECK_EQ(ske_sandbox_build(&pol, SKE_SANDBOX_LOAD, &prog), 0);
     const uint64_t ctl[6] = {0, 4096, PROT_READ | PROT_WRITE, MAP_SHARED, CTL_FD, 0};
@@ -249,9 +249,33 @@ static void test_no_ports(void)
     CHECK_EQ(run(&prog, ARCH, SYS_mmap, anon), ALLOW);
 }
 
+static void test_output_file(void)
+{
+    /* A partition with an output file (ima:Linux OutputFile) writes and syncs that one
+     * descriptor besides standard output and error, and no other; without one, neither. */
+    const int32_t out = PORT_HI + 1;
+    ske_sandbox_policy_t pol = {0, SELF, 0, 0, out};
+    ske_sandbox_prog_t prog;
+    CHECK_EQ(ske_sandbox_build(&pol, SKE_SANDBOX_RUN, &prog), 0);
+    const uint64_t to_out[6] = {(uint64_t)out, 0, 320, 0, 0, 0};
+    const uint64_t to_err[6] = {STDERR_FILENO, 0, 1, 0, 0, 0};
+    const uint64_t to_port[6] = {PORT_LO, 0, 1, 0, 0, 0};
+    CHECK_EQ(run(&prog, ARCH, SYS_write, to_out), ALLOW);
+    CHECK_EQ(run(&prog, ARCH, SYS_write, to_err), ALLOW);
+    CHECK_EQ(run(&prog, ARCH, SYS_write, to_port), ARGS);
+    CHECK_EQ(run(&prog, ARCH, SYS_fdatasync, to_out), ALLOW);
+    CHECK_EQ(run(&prog, ARCH, SYS_fdatasync, to_err), ARGS);
+    CHECK(run(&prog, ARCH, SYS_openat, to_out) != ALLOW);
+    ske_sandbox_policy_t none = {0, SELF, 0, 0, -1};
+    CHECK_EQ(ske_sandbox_build(&none, SKE_SANDBOX_RUN, &prog), 0);
+    CHECK_EQ(run(&prog, ARCH, SYS_write, to_out), ARGS);
+    CHECK(run(&prog, ARCH, SYS_fdatasync, to_out) != ALLOW);
+}
+
 int main(void)
 {
     RUN(test_normal_partition);
+    RUN(test_output_file);
     RUN(test_load_stage);
     RUN(test_system_partition);
     RUN(test_no_ports);

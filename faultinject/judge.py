@@ -187,7 +187,19 @@ def judge(run_dir: Path, golden_dir: Path | None, plan: Plan, system, duration_s
                 ctx.redundant, f.target.node == "*") else None,
         })
     run_outcome = min(outcomes, key=SEVERITY.index) if outcomes else "not_activated"
-    bad = [f["id"] for f in faults if f["outcome"] not in f["expected_outcomes"]]
+    # In a run of several faults the degradation may be another's: a fault whose class expects
+    # it to be detected and recovered from may end degraded when another fault of the run
+    # degraded the system, as that one's class allows.
+    degraders = [f["id"] for f in faults if f["outcome"] == "detected_degraded"
+                 and "detected_degraded" in f["expected_outcomes"]]
+    for f in faults:
+        others = [g for g in degraders if g != f["id"]]
+        if f["outcome"] == "detected_degraded" and others and \
+                "detected_degraded" not in f["expected_outcomes"] and \
+                "detected_recovered" in f["expected_outcomes"]:
+            f["degraded_by"] = others
+    bad = [f["id"] for f in faults if f["outcome"] not in f["expected_outcomes"]
+           and not f.get("degraded_by")]
     verdicts["outcome"] = {"verdict": "fail" if bad else "pass", "outcome": run_outcome,
                            "unexpected": bad}
     violations = sorted(k for k, v in verdicts.items() if v.get("verdict") == "fail")

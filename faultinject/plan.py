@@ -91,6 +91,10 @@ def check_target(system, f: Fault) -> None:
     if p is None:
         raise FaultSpecError(f"fault {f.fid} ({f.spec()}): no partition '{t.partition}' "
                              f"(partitions: {', '.join(x.name for x in system.partitions)})")
+    if f.cls == "disk_full" and not p.output_file:
+        raise FaultSpecError(f"fault {f.fid} ({f.spec()}): {p.name} has no output file (no "
+                             "output_file in the system model): disk_full fills the disk under "
+                             "one")
     if t.process is not None and t.process not in [x.name for x in p.processes]:
         raise FaultSpecError(f"fault {f.fid} ({f.spec()}): {p.name} has no process "
                              f"'{t.process}'")

@@ -5,9 +5,12 @@
  * (a module reset, and a spell that finds its partition not running). */
 #include "ske__supervisor.h"
 
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 
 /* What a class needs: a port of a given kind and direction, a process, a value. */
 enum {
@@ -19,6 +22,7 @@ enum {
     TAKES_VALUE = 1u << 5,
     STATE_FAULT = 1u << 6, /* active over its spells, cleared after */
     NEEDS_MEMORY_LIMIT = 1u << 7,
+    NEEDS_OUTPUT_FILE = 1u << 8,
 };
 
 typedef struct {
@@ -44,6 +48,7 @@ static const class_info_t classes[] = {
     {"queuing_flood", SKE_FAULT_QUEUING_FLOOD, NEEDS_PARTITION | PORT_SOURCE_QUEUING | STATE_FAULT},
     {"foreign_port_write", SKE_FAULT_FOREIGN_PORT_WRITE, NEEDS_PARTITION | PORT_DESTINATION},
     {"module_reset", SKE_FAULT_MODULE_RESET, 0},
+    {"disk_full", SKE_FAULT_DISK_FULL, NEEDS_PARTITION | STATE_FAULT | NEEDS_OUTPUT_FILE},
 };
 #define N_CLASSES (sizeof classes / sizeof classes[0])
 
@@ -179,6 +184,9 @@ static int check_target(ske_fault_t *f, const class_info_t *ci, const ske_module
             f->value_ns = longest_window(m, f->partition) + 1000000;
         }
     }
+    if ((ci->flags & NEEDS_OUTPUT_FILE) && !p->output_file[0])
+        return refuse(err, errlen, text, "%s cannot apply: partition '%s' has no output file "
+                      "(no ima:Linux OutputFile)", ci->name, p->name);
     if (ci->flags & NEEDS_MEMORY_LIMIT) {
         if (p->memory_bytes == 0)
             return refuse(err, errlen, text, "%s cannot apply: partition '%s' has no memory limit "
@@ -218,7 +226,7 @@ int ske__faults_parse(ske_faults_t *fs, const ske_module_cfg_t *m, const char *c
         int rc = check_target(f, ci, m, text, err, errlen);
         if (rc != SKE_OK)
             return rc;
-        if (f->partition >= 0) {
+        if (f->partition >= 0 && f->cls != SKE_FAULT_DISK_FULL) {
             if (per_partition[f->partition] == SKE_FAULT_SLOTS)
                 return refuse(err, errlen, text, "more than %d faults for partition '%s'",
                               SKE_FAULT_SLOTS, m->partitions[f->partition].name);
@@ -236,8 +244,8 @@ void ske__faults_fill_ctl(const ske_t *s, const ske_part_t *p)
     c->n_faults = 0;
     for (int i = 0; i < s->faults.n; i++) {
         const ske_fault_t *f = &s->faults.f[i];
-        if (f->partition != p->index)
-            continue;
+        if (f->partition != p->index || f->cls == SKE_FAULT_DISK_FULL)
+            continue; /* (a full disk is the SKE's to make) */
         ske_fault_slot_t *sl = &c->faults[f->slot];
         memset(sl, 0, sizeof *sl);
         sl->cls = (uint32_t)f->cls;
@@ -304,7 +312,7 @@ void ske__faults_window_start(ske_t *s, ske_part_t *p, int64_t t)
         return;
     for (int i = 0; i < s->faults.n; i++) {
         ske_fault_t *f = &s->faults.f[i];
-        if (f->partition != p->index)
+        if (f->partition != p->index || f->cls == SKE_FAULT_DISK_FULL)
             continue;
         int64_t k = fi_spec_spell(&f->spec, t);
         char detail[96];
@@ -319,6 +327,59 @@ void ske__faults_window_start(ske_t *s, ske_part_t *p, int64_t t)
             int n = snprintf(detail, sizeof detail, "the partition is not running (%s)",
                              ske__pstate_name(p->state));
             trace_fault(s, t, "ske", f, SKE_FAULT_REFUSED, detail, (size_t)n);
+        }
+    }
+}
+
+/* The file-size limit of the partition's running process: `limit` bytes, or none (-1). */
+static int set_output_limit(ske_part_t *p, int64_t limit)
+{
+    p->output_limit = limit;
+    if (!ske__alive(p) || p->pid <= 0)
+        return 0; /* its next process gets it at its start (spawn.c) */
+    struct rlimit rl = {.rlim_cur = limit < 0 ? RLIM_INFINITY : (rlim_t)limit,
+                        .rlim_max = RLIM_INFINITY};
+    return prlimit(p->pid, RLIMIT_FSIZE, &rl, NULL);
+}
+
+/* A full disk under a partition's output file: from the start of a spell to its end the
+ * file cannot grow. The SKE sets the file-size limit (RLIMIT_FSIZE) of the partition's
+ * processes to the file's size then; a partition with an output file ignores SIGXFSZ
+ * (spawn.c), so its writes fail with EFBIG, as they would with ENOSPC on a full disk. */
+void ske__faults_output(ske_t *s, ske_part_t *p, int64_t t)
+{
+    for (int i = 0; i < s->faults.n; i++) {
+        ske_fault_t *f = &s->faults.f[i];
+        if (f->partition != p->index || f->cls != SKE_FAULT_DISK_FULL)
+            continue;
+        int64_t k = fi_spec_spell(&f->spec, t);
+        char detail[128];
+        int n;
+        if (f->active && k != f->done_spell) {
+            f->active = false;
+            int rc = set_output_limit(p, -1);
+            n = rc == 0 ? snprintf(detail, sizeof detail, "the output file can grow again")
+                        : snprintf(detail, sizeof detail, "prlimit: %s", strerror(errno));
+            trace_fault(s, t, "ske", f, SKE_FAULT_CLEARED, detail, (size_t)n);
+        }
+        if (k >= 0 && k > f->done_spell) {
+            f->done_spell = k;
+            struct stat st;
+            if (fstat(p->output_fd, &st) != 0) {
+                n = snprintf(detail, sizeof detail, "fstat: %s", strerror(errno));
+                trace_fault(s, t, "ske", f, SKE_FAULT_REFUSED, detail, (size_t)n);
+                continue;
+            }
+            if (set_output_limit(p, (int64_t)st.st_size) != 0) {
+                n = snprintf(detail, sizeof detail, "prlimit: %s", strerror(errno));
+                p->output_limit = -1;
+                trace_fault(s, t, "ske", f, SKE_FAULT_REFUSED, detail, (size_t)n);
+                continue;
+            }
+            f->active = true;
+            n = snprintf(detail, sizeof detail, "the output file is full at %lld bytes: its "
+                         "writes fail (EFBIG)", (long long)st.st_size);
+            trace_fault(s, t, "ske", f, SKE_FAULT_APPLIED, detail, (size_t)n);
         }
     }
 }

@@ -13,12 +13,14 @@
 
 #define SKE_MAX_FAULTS 64 /* --fault options */
 #define SKE_MAX_SWITCHES 16 /* --test-switch options */
-#define SKE_FAULT_MODULE_RESET SKE_FAULT_CLASSES /* the one class the SKE commits itself */
+/* The classes the SKE commits itself (not the partition's fault hook). */
+#define SKE_FAULT_MODULE_RESET SKE_FAULT_CLASSES
+#define SKE_FAULT_DISK_FULL (SKE_FAULT_CLASSES + 1)
 
 /* One injected fault and what happened to it so far. */
 typedef struct {
     fi_spec_t spec;
-    int cls; /* ske_fault_class_t, or SKE_FAULT_MODULE_RESET */
+    int cls; /* ske_fault_class_t, SKE_FAULT_MODULE_RESET or SKE_FAULT_DISK_FULL */
     int partition; /* index; -1 for a module reset */
     int slot; /* in the partition's control block */
     int port; /* index in the partition's ports, -1: none */

@@ -63,6 +63,7 @@ typedef struct {
     uint64_t restarts;
     bool exit_to_judge; /* ended on its own: the health monitor has yet to decide */
     int output_fd; /* its output file, opened by the SKE (output.c); -1: none */
+    int64_t output_limit; /* disk_full: the file size its processes may not write past; -1 */
     uint64_t hm_log_lost; /* HM decisions its full health-monitor log port could not take */
 } ske_part_t;
 
@@ -185,6 +186,9 @@ bool ske__fault_event(ske_t *s, ske_part_t *p, int64_t t, int32_t slot, int32_t 
                       const char *text, size_t len);
 /* At a window of a partition that is not running: the spells that started are refused. */
 void ske__faults_window_start(ske_t *s, ske_part_t *p, int64_t t);
+/* At each window of a partition: a full disk under its output file (disk_full) that
+ * starts or ends. */
+void ske__faults_output(ske_t *s, ske_part_t *p, int64_t t);
 /* At a major frame's start: a module reset due. */
 void ske__faults_frame_start(ske_t *s, int64_t t, int64_t frame);
 

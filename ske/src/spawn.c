@@ -11,6 +11,7 @@
 #include <string.h>
 #include <sys/personality.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -139,6 +140,16 @@ static void child_exec(ske_t *s, ske_part_t *p, int errpipe, char **envp)
     sigaction(SIGTERM, &dfl, NULL);
     sigaction(SIGCHLD, &dfl, NULL);
     sigaction(SIGPIPE, &dfl, NULL); /* the SKE ignores it; a partition gets the default */
+    if (p->output_fd >= 0) {
+        /* A write past the file-size limit fails (EFBIG) instead of killing the writer: a
+         * full disk under its output file (disk_full) is an error it sees, as ENOSPC. */
+        struct sigaction ign = {.sa_handler = SIG_IGN};
+        sigaction(SIGXFSZ, &ign, NULL);
+        if (p->output_limit >= 0) {
+            struct rlimit rl = {.rlim_cur = (rlim_t)p->output_limit, .rlim_max = RLIM_INFINITY};
+            setrlimit(RLIMIT_FSIZE, &rl);
+        }
+    }
     sigset_t none;
     sigemptyset(&none);
     sigprocmask(SIG_SETMASK, &none, NULL);

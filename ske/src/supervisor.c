@@ -76,6 +76,7 @@ int ske_create(const ske_module_cfg_t *cfg, const ske_run_opts_t *opts, ske_t **
         p->state = SKE_PS_NOT_STARTED;
         p->ctl_fd = -1;
         p->output_fd = -1;
+        p->output_limit = -1;
         p->start_condition = 0; /* NORMAL_START */
         p->initial_mode = SKE_MODE_COLD_START;
         for (int k = 0; k < SKE_MAX_PORTS; k++)

@@ -315,6 +315,7 @@ int ske__run_window(ske_t *s, const ske_slot_t *slot, char *err, size_t errlen)
     }
     ske_trace_end(&s->trace);
     ske__faults_window_start(s, p, start);
+    ske__faults_output(s, p, start);
 
     wres_t r = W_EXIT;
     ov_cause_t cause = OV_CPU_BUDGET;

@@ -119,17 +119,20 @@ def test_generate_result(triplex: DeployResult) -> None:
     out = triplex.out_dir
     assert triplex.modules == {n: out / f"{n}.xml" for n in ("node1", "node2", "node3")}
     assert triplex.glue == [out / "glue" / "io_ports.h", out / "glue" / "nav_fcs_ports.h",
-                            out / "glue" / "rpas_system.h"]
+                            out / "glue" / "fdr_ports.h", out / "glue" / "rpas_system.h"]
     json.dumps(triplex.summary)  # JSON-able
     s = triplex.summary
     assert [(p["name"], p["node"]) for p in s["partitions"]] == [
-        (p, n) for n in ("node1", "node2", "node3") for p in ("io", "nav_fcs")]
+        (p, n) for n in ("node1", "node2", "node3") for p in ("io", "nav_fcs", "fdr")]
     io_ = s["partitions"][0]
     assert io_ == {**io_, "personality": "apex-c", "rate_hz": 20.0, "processes": ["rx", "tx"],
                    "inputs": ["ACT_CMD_IN", "FCS_STATUS_IN", "NAV_IN"],
                    "outputs": ["GPS_OUT", "AHRS_OUT", "AIR_OUT", "PILOT_OUT", "ACT_OUT"],
                    "criticality": "LEVEL_A", "replicated": False, "system_partition": True}
     assert s["partitions"][1]["replicated"] is True
+    fdr = s["partitions"][2]
+    assert fdr == {**fdr, "criticality": "LEVEL_E", "replicated": False,
+                   "inputs": ["NAV_IN", "FCS_STATUS_IN", "MISSION_IN", "HM_LOG_IN"], "outputs": []}
     assert s["channels"] == {"intra_node": 8, "can_messages": 22, "dds_topics": 4}
     assert s["total_lines"] == sum(n for _, n in triplex.files)
 
@@ -176,7 +179,8 @@ def test_simplex_deploys_one_module(tmp_path: Path) -> None:
     result = generate(load_system(SIMPLEX), tmp_path)
     assert list(result.modules) == ["node1"]
     assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*") if p.is_file()) \
-        == ["glue/io_ports.h", "glue/nav_fcs_ports.h", "glue/rpas_system.h", "node1.xml"]
+        == ["glue/fdr_ports.h", "glue/io_ports.h", "glue/nav_fcs_ports.h", "glue/rpas_system.h",
+            "node1.xml"]
     assert result.summary["channels"] == {"intra_node": 8, "can_messages": 14, "dds_topics": 4}
     assert "#define RPAS_NODE_COUNT      1" in (tmp_path / "glue" / "rpas_system.h").read_text()
 
@@ -418,14 +422,14 @@ def test_command_prints_the_summary(tmp_path: Path, capsys) -> None:
     header = out.splitlines()[2].split()
     assert header == ["Partition", "Node", "Guest", "Rate", "Processes", "Inputs", "Outputs",
                       "Criticality", "Replicated"]
-    rows = [line.split() for line in out.splitlines()[3:9]]
+    rows = [line.split() for line in out.splitlines()[3:12]]
     assert [r[:4] for r in rows] == [[p, n, "apex-c", "20"] for n in ("node1", "node2", "node3")
-                                     for p in ("io", "nav_fcs")]
-    assert [r[-1] for r in rows] == ["no", "yes"] * 3
+                                     for p in ("io", "nav_fcs", "fdr")]
+    assert [r[-1] for r in rows] == ["no", "yes", "no"] * 3
     assert "Channels: 8 intra-node per node, 22 CAN messages, 4 DDS topics" in out
-    assert "Generated 6 files, " in out
+    assert "Generated 7 files, " in out
     for name in ("node1.xml", "node2.xml", "node3.xml", "glue/io_ports.h",
-                 "glue/nav_fcs_ports.h", "glue/rpas_system.h"):
+                 "glue/nav_fcs_ports.h", "glue/fdr_ports.h", "glue/rpas_system.h"):
         assert name in out
     assert (tmp_path / "node3.xml").is_file()
 
@@ -441,7 +445,7 @@ def test_command_json(tmp_path: Path, capsys) -> None:
     assert summary["channels"] == {"intra_node": 8, "can_messages": 22, "dds_topics": 4}
     assert [f["path"] for f in summary["files"]] == [
         "node1.xml", "node2.xml", "node3.xml", "glue/io_ports.h", "glue/nav_fcs_ports.h",
-        "glue/rpas_system.h"]
+        "glue/fdr_ports.h", "glue/rpas_system.h"]
 
 
 def test_summary_on_a_terminal_is_a_table(triplex: DeployResult) -> None:

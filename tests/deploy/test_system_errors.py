@@ -262,7 +262,7 @@ SEMANTIC_CASES = [
      "channels.intra_node[0].from: partition 'io' has no port named 'GPS_OUTX' (its ports: "
      "GPS_OUT, ", "io.GPS_OUTX"),
     ("unknown channel partition", lambda d: d["channels"]["intra_node"][1].update(to="nav.AHRS_IN"),
-     "channels.intra_node[1].to: no partition named 'nav' (partitions: io, nav_fcs)",
+     "channels.intra_node[1].to: no partition named 'nav' (partitions: io, nav_fcs, fdr)",
      "nav.AHRS_IN"),
     ("source is a destination port",
      lambda d: d["channels"]["intra_node"][0].update({"from": "nav_fcs.MISSION_IN"}),
@@ -298,7 +298,7 @@ SEMANTIC_CASES = [
      "schedule.major_frame_s: 0.0500000001 is not a whole number of nanoseconds",
      "major_frame_s"),
     ("replicated partition unknown", lambda d: d.update(replicated=["fcs"]),
-     "replicated[0]: no partition named 'fcs' (partitions: io, nav_fcs)", "- fcs"),
+     "replicated[0]: no partition named 'fcs' (partitions: io, nav_fcs, fdr)", "- fcs"),
     ("process level during initialisation",
      lambda d: d["health_monitoring"]["system"]["PARTITION_INIT"].update(
          NUMERIC_ERROR="PROCESS"),

@@ -132,12 +132,14 @@ def test_a_recording_survives_kill_9_of_the_whole_run(tmp_path):
 
 
 @pytest.mark.parametrize("spec", ["fdr@node1:partition_crash@3~1", "fdr@node1:partition_crash@3",
-                                  "fdr@node1:cpu_overrun@3~2"],
-                         ids=["killed", "crash-loop", "overrun"])
+                                  "fdr@node1:cpu_overrun@3~2", "fdr@node1:partition_hang@3~1",
+                                  "fdr@node1:disk_full@3~2"],
+                         ids=["killed", "crash-loop", "overrun", "hung", "disk-full"])
 def test_the_recorders_loss_changes_nothing(spec, tmp_path):
-    """Killed once, crashing in a loop, overrunning its window: the truth is bit-identical to
-    the run without the fault, and every other partition's windows and messages are those of
-    that run (the oracles of docs/fault-injection.md, against its golden run)."""
+    """Killed once, crashing in a loop, overrunning its window, hung, its disk full: the
+    truth is bit-identical to the run without the fault, and every other partition's windows
+    and messages are those of that run (the oracles of docs/fault-injection.md, against its
+    golden run)."""
     run_dir = tmp_path / "run"
     p = subprocess.run([str(ROOT / "ima"), "launch", str(TRIPLEX), "--duration", "8",
                         "--fault", spec, "--run-dir", str(run_dir), "--json"],
@@ -151,6 +153,12 @@ def test_the_recorders_loss_changes_nothing(spec, tmp_path):
         assert o[name]["verdict"] == "pass", (name, o[name])
     rec = records.read(run_dir / "node1.fdr")
     assert rec.summary()["torn"] == 0
-    if spec.endswith("~1"):  # restarted once: it records its own end, and the frame it lost
-        assert [(h["partition"], h["error"]) for h in rec.hm] == [("fdr", "PARTITION_EXIT")]
+    errors = [(h["partition"], h["error"]) for h in rec.hm]
+    if "partition_crash@3~1" in spec:  # restarted once: it records its own end and the gap
+        assert errors == [("fdr", "PARTITION_EXIT")]
         assert len(rec.starts) == 2 and rec.summary()["missing_frames"] >= 1
+    if "disk_full" in spec:  # its writes failed for 2 s: restarted, recording again after
+        assert errors and set(errors) == {("fdr", "APPLICATION_ERROR")}, errors
+        assert len(rec.starts) >= 2 and rec.frames[-1]["t_ns"] > 7.5e9
+        assert 30 <= rec.summary()["missing_frames"] <= 45, rec.summary()
+    assert s["faults"][0]["outcome"] == "detected_recovered", s["faults"][0]

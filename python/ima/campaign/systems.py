@@ -47,8 +47,13 @@ def with_mission_feed(system: Path, dest: Path, feed: dict) -> Path:
         "memory": [{"type": "DATA", "size": 0x2000000, "access": "READ_WRITE"}]}]
     doc["schedule"] = dict(doc["schedule"], windows=list(doc["schedule"]["windows"]) +
                            [FEED_WINDOW])
+    # the targets go to nav_fcs, and to every other partition that takes them (the flight
+    # data recorder records them)
+    takers = [f"{p['name']}.MISSION_IN" for p in doc["partitions"]
+              if any(q["name"] == "MISSION_IN" and q["direction"] == "destination"
+                     for q in p.get("ports") or [])]
     doc["channels"] = dict(doc["channels"], intra_node=list(doc["channels"]["intra_node"]) + [
-        {"name": "mission", "from": "mission_feed.MISSION_OUT", "to": "nav_fcs.MISSION_IN"},
+        {"name": "mission", "from": "mission_feed.MISSION_OUT", "to": takers},
         {"name": "feed_log", "from": "mission_feed.FEED_LOG_OUT",
          "to": "mission_feed.FEED_LOG_IN"}])
     dest.parent.mkdir(parents=True, exist_ok=True)

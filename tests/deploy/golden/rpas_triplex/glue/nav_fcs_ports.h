@@ -132,7 +132,7 @@ RPAS_GLUE_CHECK(sizeof(rpas_mission_msg_t) == NAV_FCS_PORT_MISSION_IN_SIZE,
 RPAS_GLUE_CHECK(sizeof(rpas_act_cmd_msg_t) == NAV_FCS_PORT_ACT_CMD_OUT_SIZE,
     "nav_fcs.ACT_CMD_OUT: sizeof(rpas_act_cmd_msg_t) differs from the port size in the model (48)");
 
-/* FCS_STATUS_OUT: sampling source, channel 7 'fcs_status' to io.FCS_STATUS_IN */
+/* FCS_STATUS_OUT: sampling source, channel 7 'fcs_status' to io.FCS_STATUS_IN, fdr.FCS_STATUS_IN */
 #define NAV_FCS_PORT_FCS_STATUS_OUT_NAME         "FCS_STATUS_OUT"
 #define NAV_FCS_PORT_FCS_STATUS_OUT_KIND         RPAS_PORT_SAMPLING
 #define NAV_FCS_PORT_FCS_STATUS_OUT_DIRECTION    SOURCE /* PORT_DIRECTION_TYPE */
@@ -144,7 +144,7 @@ RPAS_GLUE_CHECK(sizeof(rpas_act_cmd_msg_t) == NAV_FCS_PORT_ACT_CMD_OUT_SIZE,
 RPAS_GLUE_CHECK(sizeof(rpas_fcs_status_msg_t) == NAV_FCS_PORT_FCS_STATUS_OUT_SIZE,
     "nav_fcs.FCS_STATUS_OUT: sizeof(rpas_fcs_status_msg_t) differs from the port size in the model (72)");
 
-/* NAV_OUT: sampling source, channel 8 'navigation' to io.NAV_IN */
+/* NAV_OUT: sampling source, channel 8 'navigation' to io.NAV_IN, fdr.NAV_IN */
 #define NAV_FCS_PORT_NAV_OUT_NAME         "NAV_OUT"
 #define NAV_FCS_PORT_NAV_OUT_KIND         RPAS_PORT_SAMPLING
 #define NAV_FCS_PORT_NAV_OUT_DIRECTION    SOURCE /* PORT_DIRECTION_TYPE */

@@ -14,6 +14,7 @@
 #include "ARINC653.h"
 #include "fdr.h"
 #include "fdr_ports.h"
+#include "rpas/process.h"
 #include "rpas/report.h"
 
 enum {
@@ -154,22 +155,12 @@ int main(int argc, char **argv)
     put(start, sizeof start);
 
     const rpas_process_spec_t *ps = &fdr_process_spec[FDR_PROCESS_RECORD];
-    PROCESS_ATTRIBUTE_TYPE attr = {
-        .PERIOD = ps->period_ns,
-        .TIME_CAPACITY = ps->period_ns,
-        .ENTRY_POINT = (SYSTEM_ADDRESS_TYPE)cycle,
-        .STACK_SIZE = ps->stack_size,
-        .BASE_PRIORITY = ps->priority,
-        .DEADLINE = ps->deadline,
-    };
-    snprintf(attr.NAME, sizeof attr.NAME, "%s", ps->name);
     PROCESS_ID_TYPE pid;
-    CREATE_PROCESS(&attr, &pid, &rc);
+    rpas_start_process(ps, cycle, &pid, &rc);
     if (rc != NO_ERROR) {
-        fail("CREATE_PROCESS record", rc);
+        fail(ps->name, rc);
         return 1;
     }
-    START(pid, &rc);
     SET_PARTITION_MODE(NORMAL, &rc);
     return 0;
 }

@@ -17,6 +17,7 @@
 #include "canbus/client.h"
 #include "io_core.h"
 #include "io_ports.h"
+#include "rpas/process.h"
 #include "rpas/report.h"
 #include "xch/client.h"
 
@@ -281,22 +282,10 @@ int main(int argc, char *argv[])
     }
     void (*entry[IO_PROCESS_COUNT])(void) = {[IO_PROCESS_RX] = rx_process, [IO_PROCESS_TX] = tx_process};
     for (int i = 0; i < IO_PROCESS_COUNT; i++) {
-        const rpas_process_spec_t *s = &io_process_spec[i];
-        PROCESS_ATTRIBUTE_TYPE a = {.PERIOD = s->period_ns, .TIME_CAPACITY = s->period_ns,
-                                    .ENTRY_POINT = (SYSTEM_ADDRESS_TYPE)entry[i],
-                                    .STACK_SIZE = s->stack_size, .BASE_PRIORITY = s->priority,
-                                    .DEADLINE = s->deadline};
-        snprintf(a.NAME, sizeof a.NAME, "%s", s->name);
         PROCESS_ID_TYPE pid;
-        CREATE_PROCESS(&a, &pid, &rc);
+        rpas_start_process(&io_process_spec[i], entry[i], &pid, &rc);
         if (rc != NO_ERROR)
-            return fail(s->name, rc);
-        if (s->offset_ns)
-            DELAYED_START(pid, s->offset_ns, &rc);
-        else
-            START(pid, &rc);
-        if (rc != NO_ERROR)
-            return fail(s->name, rc);
+            return fail(io_process_spec[i].name, rc);
     }
     SET_PARTITION_MODE(NORMAL, &rc);
     return fail("SET_PARTITION_MODE NORMAL", rc);

@@ -9,6 +9,7 @@
 #include "fcs.h"
 #include "nav.h"
 #include "nav_fcs_ports.h"
+#include "rpas/process.h"
 #include "rpas/report.h"
 
 /* Port indices: the contract's (nav_fcs_ports.h, generated from the system model). */
@@ -132,24 +133,10 @@ int main(void)
     fcs_init(&app.fcs, NULL);
 
     const rpas_process_spec_t *ps = &nav_fcs_process_spec[NAV_FCS_PROCESS_NAV_FCS];
-    PROCESS_ATTRIBUTE_TYPE attr = {
-        .PERIOD = ps->period_ns,
-        .TIME_CAPACITY = ps->period_ns,
-        .ENTRY_POINT = (SYSTEM_ADDRESS_TYPE)cycle,
-        .STACK_SIZE = ps->stack_size,
-        .BASE_PRIORITY = ps->priority,
-        .DEADLINE = ps->deadline,
-    };
-    snprintf(attr.NAME, sizeof attr.NAME, "%s", ps->name);
     PROCESS_ID_TYPE pid;
-    CREATE_PROCESS(&attr, &pid, &rc);
+    rpas_start_process(ps, cycle, &pid, &rc);
     if (rc != NO_ERROR) {
-        fail("CREATE_PROCESS nav_fcs", rc);
-        return 1;
-    }
-    START(pid, &rc);
-    if (rc != NO_ERROR) {
-        fail("START nav_fcs", rc);
+        fail(ps->name, rc);
         return 1;
     }
     SET_PARTITION_MODE(NORMAL, &rc);

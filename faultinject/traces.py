@@ -434,13 +434,22 @@ class RunTraces:
     # -- the DDS agents ---------------------------------------------------------------------
     @functools.cached_property
     def dds(self) -> dict[str, list[dict]]:
-        """Each agent's trace up to its `dds_stop`: what it saw of the run. At the end of the
-        run the agents are stopped one by one, and each sees the others go (`dds_peer_lost`)."""
+        """Each agent's trace up to the end of the run: what it saw of the run. At the end the
+        agents are stopped one by one, and those stopped later see the first ones go
+        (`dds_peer_lost`, writer gone): every trace is cut where the first agent was stopped
+        (the wall-clock time of the first `dds_stop` of the run's last frame), each at its
+        own `dds_stop` at the latest."""
+        traces = {n: read_jsonl(self.run_dir / f"dds{k}.jsonl")
+                  for k, n in enumerate(self.nodes, start=1)}
+        last = max((e.get("t_ns", 0) for events in traces.values() for e in events), default=0)
+        ends = [e["t_wall_ns"] for events in traces.values() for e in events
+                if e.get("kind") == "dds_stop" and isinstance(e.get("t_wall_ns"), int)
+                and e.get("t_ns", 0) >= last - 50_000_000]
+        first_stop = min(ends, default=None)
         out = {}
-        for k, n in enumerate(self.nodes, start=1):
-            events = read_jsonl(self.run_dir / f"dds{k}.jsonl")
-            stop = next((i for i, e in enumerate(events) if e.get("kind") == "dds_stop"),
-                        len(events))
+        for n, events in traces.items():
+            stop = next((i for i, e in enumerate(events) if e.get("kind") == "dds_stop" or (
+                first_stop is not None and e.get("t_wall_ns", 0) >= first_stop)), len(events))
             out[n] = events[:stop]
         return out
 

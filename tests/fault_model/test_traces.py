@@ -80,3 +80,22 @@ def test_a_cut_line_sorts_last():
     assert t_ns_of(b'{"t_ns":12,"kind":"x"}') == 12
     assert t_ns_of(b'{"t_ns":') == 1 << 62
     assert t_ns_of(b'{"kind":"x","t_ns":7}') == 7
+
+
+def test_the_agents_traces_end_where_the_first_agent_was_stopped(tmp_path):
+    """At the end of a run the agents are stopped one by one: the later ones see the first go
+    (its writers gone), which is the run's end, not a detection."""
+    (tmp_path / "launch.json").write_text(json.dumps({"nodes": ["node1", "node2"]}))
+    end = 20_000_000_000 - 50_000_000
+
+    def ev(t_wall, kind, t=end, **kw):
+        return {"t_wall_ns": t_wall, "t_ns": t, "node": "n", "src": "dds", "kind": kind, **kw}
+    _write(tmp_path / "dds1.jsonl", [ev(1, "dds_ready", t=0),
+                                     ev(5, "dds_deadline_missed", t=9_000_000_000, peer="node2"),
+                                     ev(100, "dds_stop", signal=15), ev(101, "dds_exit")])
+    _write(tmp_path / "dds2.jsonl", [ev(2, "dds_ready", t=0),
+                                     ev(102, "dds_peer_lost", peer="node1", reason="writer_gone"),
+                                     ev(110, "dds_stop", signal=15)])
+    dds = RunTraces(tmp_path).dds
+    assert [e["kind"] for e in dds["node1"]] == ["dds_ready", "dds_deadline_missed"]
+    assert [e["kind"] for e in dds["node2"]] == ["dds_ready"]

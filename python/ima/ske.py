@@ -63,7 +63,7 @@ def build_command(
     if node is not None:
         cmd += ["--node", node]
     cmd += list(extra_args)
-    cmd.append(str(module_xml))
+    cmd += ["--", str(module_xml)]  # a module path that starts with '-' is no option
     return cmd
 
 
@@ -205,7 +205,7 @@ def run_module(
 def check_module(module_xml: str | os.PathLike, timeout: float = 60.0) -> tuple[int, str]:
     """Validates a module with `ima-ske --check`; returns (exit code, its standard error text)."""
     binary = paths.ske_binary()
-    cmd = [str(binary), "--check", str(module_xml)]
+    cmd = [str(binary), "--check", "--", str(module_xml)]
     try:
         done = subprocess.run(
             cmd,

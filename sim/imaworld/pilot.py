@@ -10,6 +10,7 @@ from pathlib import Path
 import jsonschema
 import yaml
 
+from ima import yamlfile
 from ima.errors import ImaError
 
 MODES = ("DIRECT", "AUTOPILOT", "MISSION")
@@ -183,8 +184,26 @@ class PilotScript:
         return out
 
 
+def _not_finite(value, where: tuple = ()) -> tuple[tuple, float] | None:
+    """The first NaN or infinity in the document (JSON Schema's bounds let them through: every
+    comparison with NaN is false), with where it is."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return where, value
+    items = value.items() if isinstance(value, dict) else enumerate(value) \
+        if isinstance(value, list) else ()
+    for k, v in items:
+        found = _not_finite(v, where + (k,))
+        if found is not None:
+            return found
+    return None
+
+
 def parse(doc, path: str = "<script>") -> PilotScript:
     """Validate a parsed YAML document and build the script; PilotScriptError if it is bad."""
+    bad = _not_finite(doc)
+    if bad is not None:
+        where, val = bad
+        raise PilotScriptError(f"{path}: {_path(where)}: {val} is not a finite number")
     v = jsonschema.Draft202012Validator(SCHEMA)
     errors = sorted(v.iter_errors(doc), key=lambda e: (list(map(str, e.absolute_path)), e.message))
     if errors:
@@ -197,16 +216,9 @@ def parse(doc, path: str = "<script>") -> PilotScript:
             raise PilotScriptError(f"{path}: events[{i}].t: {events[i]['t']} comes before the "
                                    f"previous event's t ({events[i - 1]['t']}); keep events in "
                                    "time order")
-    for i, e in enumerate(events):
-        for k, val in e.items():
-            if isinstance(val, float) and not math.isfinite(val):
-                raise PilotScriptError(f"{path}: events[{i}].{k}: {val} is not a finite number")
     start = dict(doc["start"])
     start.setdefault("lat_deg", 47.0)
     start.setdefault("lon_deg", 8.0)
-    for k, val in start.items():
-        if not math.isfinite(val):
-            raise PilotScriptError(f"{path}: start.{k}: {val} is not a finite number")
     return PilotScript(
         path=path, start=start, events=events,
         settle_s=(doc.get("evaluate") or {}).get("settle_s"),
@@ -218,11 +230,16 @@ def parse(doc, path: str = "<script>") -> PilotScript:
 def load(path: str | Path) -> PilotScript:
     """Load and validate a pilot script file."""
     try:
-        text = Path(path).read_text()
+        text = Path(path).read_text(encoding="utf-8")
     except OSError as e:
         raise PilotScriptError(f"{path}: cannot read the pilot script: {e.strerror}") from e
+    except UnicodeDecodeError as e:
+        raise PilotScriptError(f"{path}: not a text file in UTF-8 (byte {e.start}: "
+                               f"{e.reason})") from e
     try:
-        doc = yaml.safe_load(text)
+        doc = yamlfile.load(text)
+    except yamlfile.YamlLimitError as e:
+        raise PilotScriptError(f"{path}: refused: {e}") from e
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""

@@ -163,8 +163,15 @@ static void load_memory(ske_loader_t *L, const xmlNode *n)
         if (!ske__is_elem(c, "Memory_Requirements", false))
             continue;
         uint64_t sz;
-        if (ske__attr_u64(L, c, "SizeBytes", &sz, (uint64_t)1 << 40, true))
-            p->memory_bytes += sz;
+        if (!ske__attr_u64(L, c, "SizeBytes", &sz, (uint64_t)1 << 40, true))
+            continue;
+        if (sz == 0) {
+            /* (a limit of 0 would mean none at all) */
+            ske__fail(L, c, "a memory requirement is at least one byte",
+                      "SizeBytes=\"0\": a requirement of no memory");
+            continue;
+        }
+        p->memory_bytes += sz;
     }
 }
 
@@ -240,7 +247,14 @@ static void resolve_executable(ske_loader_t *L, ske_partition_cfg_t *p)
 static void load_module(ske_loader_t *L, xmlNode *root)
 {
     ske_module_cfg_t *m = L->m;
-    ske__attr(root, "ModuleName", m->module_name, sizeof m->module_name);
+    char name[256];
+    if (!ske__attr(root, "ModuleName", name, sizeof name) || !name[0] ||
+        strlen(name) >= sizeof m->module_name) {
+        ske__fail(L, root, "a module name of 1 to 63 characters",
+                  "ModuleName is %s", name[0] ? "longer than 63 characters" : "empty");
+        return;
+    }
+    memcpy(m->module_name, name, strlen(name) + 1);
     snprintf(m->node, sizeof m->node, "node1");
     m->time_mode = SKE_TIME_EMULATED;
     hm_system_defaults(&m->hm);
@@ -309,9 +323,34 @@ int ske_config_load(const char *path, const ske_load_opts_t *opts, ske_module_cf
         free(m);
         return SKE_E_IO;
     }
+    /* Before the parser sees it: a bounded size, and no document type declaration. Module
+     * files need no DTD; one could define entities that expand beyond any bound, so none is
+     * processed at all. */
+    if (L.too_big) {
+        ske__diag_set(diag, path, 0, "", "a module file of at most 8 MiB",
+                      "the module file is larger than 8 MiB");
+        free(L.text);
+        free(L.line_at);
+        free(m);
+        return SKE_E_CONFIG;
+    }
+    const char *dtd = L.text ? memmem(L.text, L.text_len, "<!DOCTYPE", 9) : NULL;
+    if (dtd) {
+        int line = 1;
+        for (const char *q = L.text; q < dtd; q++)
+            line += *q == '\n';
+        ske__diag_set(diag, path, line, "", "no document type declaration",
+                      "a DOCTYPE: module files need no DTD, and the SKE processes none");
+        free(L.text);
+        free(L.line_at);
+        free(m);
+        return SKE_E_CONFIG;
+    }
     xmlSetGenericErrorFunc(NULL, ske__xml_silent);
     xmlSetStructuredErrorFunc(&L, ske__parse_error);
-    xmlDocPtr doc = xmlReadFile(path, NULL, XML_PARSE_NONET | XML_PARSE_BIG_LINES);
+    const int flags = XML_PARSE_NONET | XML_PARSE_BIG_LINES;
+    xmlDocPtr doc = L.text ? xmlReadMemory(L.text, (int)L.text_len, path, NULL, flags)
+                           : xmlReadFile(path, NULL, flags);
     xmlSetStructuredErrorFunc(NULL, NULL);
     int rc = SKE_OK;
     if (!doc) {

@@ -106,6 +106,10 @@ void ske__index_lines(ske_loader_t *L)
     size_t r;
     while (buf && (r = fread(buf + len, 1, cap - len, f)) > 0) {
         len += r;
+        if (len > SKE_MODULE_MAX_BYTES) {
+            L->too_big = true;
+            break;
+        }
         if (len == cap) {
             char *nb = realloc(buf, cap * 2);
             if (!nb) {

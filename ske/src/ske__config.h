@@ -15,6 +15,8 @@
 #define SKE_EXT_NS "urn:ima-testbed:arinc653-linux:1"
 #define SKE_SCHEMA_FILE "ima653_module.xsd"
 
+#define SKE_MODULE_MAX_BYTES (8u << 20) /* a module file beyond it is refused */
+
 typedef struct {
     ske_module_cfg_t *m;
     ske_diag_t *diag;
@@ -22,6 +24,7 @@ typedef struct {
     bool failed;
     char *text; /* the module file, to find where start tags begin */
     size_t text_len;
+    bool too_big; /* beyond SKE_MODULE_MAX_BYTES: not read further */
     size_t *line_at; /* offset of each line's first character, 1-based */
     int n_lines;
 } ske_loader_t;

@@ -620,3 +620,39 @@ def test_number_above_its_maximum_says_the_maximum(check, example):
         rule="numbers are within their range",
         says=("MaxNbMessages='2000000' is too large: at most 1048576",),
     )
+
+
+# ---- hostile module files --------------------------------------------------------------------
+
+
+def test_a_document_type_declaration_is_refused_before_parsing(check, example):
+    """Module files need no DTD; one could define entities that expand beyond any bound (a
+    file of a few kilobytes became hundreds of megabytes), so none is processed."""
+    entities = "".join(f'<!ENTITY e{k} "{f"&e{k - 1};" * 16 if k else "x" * 64}">'
+                       for k in range(12))
+    bad = Module(example.text.replace("<ARINC_653_Module",
+                                      f"<!DOCTYPE ARINC_653_Module [{entities}]>\n"
+                                      "<ARINC_653_Module", 1))
+    refused(check, bad, at=Where(bad.line_of("<!DOCTYPE"), bad.line_of("<!DOCTYPE")),
+            element="", rule="no document type declaration", says=("DOCTYPE",))
+
+
+def test_a_module_file_beyond_8_mib_is_refused(check, example):
+    big = Module(example.text + "<!--" + "x" * (8 << 20) + "-->\n")
+    path, r = check(big)
+    assert r.returncode == EXIT_INVALID_MODULE and "larger than 8 MiB" in r.stderr, r.stderr
+
+
+def test_a_memory_requirement_of_no_bytes_is_refused(check, example):
+    first = example.text.index("SizeBytes=")
+    value = example.text[first:example.text.index(" ", first)]
+    bad = Module(example.text.replace(value, 'SizeBytes="0"', 1))
+    refused(check, bad, at=bad.tag('SizeBytes="0"'), element="Memory_Requirements",
+            rule="a memory requirement is at least one byte", says=("SizeBytes",))
+
+
+@pytest.mark.parametrize("name, says", [("", "empty"), ("m" * 5000, "longer than 63")])
+def test_a_module_name_is_1_to_63_characters(check, example, name, says):
+    bad = example.replace('ModuleName="three_partitions"', f'ModuleName="{name}"')
+    refused(check, bad, at=bad.tag("<ARINC_653_Module"), element="ARINC_653_Module",
+            rule="a module name of 1 to 63 characters", says=(says,))

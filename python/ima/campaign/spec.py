@@ -17,7 +17,7 @@ import jsonschema
 import yaml
 
 from faultinject import catalogue, grammar
-from ima import paths
+from ima import paths, yamlfile
 from ima.errors import ImaError
 
 
@@ -83,9 +83,11 @@ def _file(base: Path, text: str, what: str) -> Path:
 def load(path: Path) -> Campaign:
     """A campaign and its runs; CampaignError naming the bad path in the file."""
     try:
-        doc = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
+        doc = yamlfile.load(Path(path).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError) as exc:
         raise CampaignError(f"{path}: cannot read: {exc}") from exc
+    except yamlfile.YamlLimitError as exc:
+        raise CampaignError(f"{path}: refused: {exc}") from exc
     except yaml.YAMLError as exc:
         raise CampaignError(f"{path}: not valid YAML: {exc}") from exc
     e = grammar.first_schema_error(jsonschema.Draft202012Validator(_schema()), doc)

@@ -12,7 +12,7 @@ import sys
 import time
 from pathlib import Path
 
-from ima import paths
+from ima import outdir, paths
 from ima.errors import ImaError
 
 
@@ -30,7 +30,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("campaign", metavar="CAMPAIGN.yaml|rerun",
                         help="the campaign file, or `rerun`")
     parser.add_argument("rest", nargs="*", metavar="DIR RUN_ID", help="with rerun")
-    parser.add_argument("--out", type=Path, metavar="DIR",
+    parser.add_argument("--out", type=outdir.dir_arg, metavar="DIR",
                         help="the campaign folder (default campaigns/NAME-<date>-<time>)")
     parser.add_argument("-j", "--jobs", type=int, default=None, metavar="N",
                         help="flights at once, one per CPU (default: the CPUs this process "
@@ -154,6 +154,7 @@ def run(args: argparse.Namespace) -> int:
     c = spec.load(Path(args.campaign))
     out = args.out or paths.repo_root() / "campaigns" / \
         f"{c.name}-{time.strftime('%Y%m%d-%H%M%S')}"
+    outdir.usable_dir(out, "--out")
     opts = runner.RunnerOptions(out=out, jobs=_jobs(args.jobs), resume=args.resume,
                                 keep_all=args.keep_all, executor=args.executor,
                                 scheduler=args.scheduler, test_switches=tuple(args.test_switch),

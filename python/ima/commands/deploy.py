@@ -9,6 +9,7 @@ import json
 import sys
 from pathlib import Path
 
+from ima import outdir
 from ima.deploy import generate, load_system
 from ima.deploy.report import print_summary
 
@@ -23,7 +24,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "generated module is invalid.",
     )
     parser.add_argument("system", metavar="SYSTEM.yaml", type=Path, help="the system model")
-    parser.add_argument("-o", "--out", metavar="DIR", type=Path, required=True,
+    parser.add_argument("-o", "--out", metavar="DIR", type=outdir.dir_arg, required=True,
                         help="where to write the modules (DIR/<node>.xml) and DIR/glue/")
     parser.add_argument("--json", action="store_true",
                         help="print the summary as one JSON object instead of the table")
@@ -31,7 +32,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    result = generate(load_system(args.system), args.out)
+    system = load_system(args.system)
+    result = generate(system, outdir.usable_dir(args.out, "--out"))
     if args.json:
         json.dump(result.summary, sys.stdout)
         sys.stdout.write("\n")

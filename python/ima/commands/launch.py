@@ -10,7 +10,7 @@ import json
 import sys
 from pathlib import Path
 
-from ima import provenance
+from ima import outdir, provenance
 from ima.errors import ImaError
 from ima.launch import faults as fault_plan
 from ima.launch import judging as judging_mod
@@ -71,7 +71,7 @@ def add_run_arguments(parser: argparse.ArgumentParser, kind: str = "launch") -> 
                         help="mean wind speed, from 270° (default 10)")
     parser.add_argument("--realtime", action="store_true",
                         help="follow the wall clock instead of running as fast as possible")
-    parser.add_argument("--run-dir", type=Path, metavar="DIR",
+    parser.add_argument("--run-dir", type=outdir.dir_arg, metavar="DIR",
                         help=f"where the traces go (default runs/{kind}-<date>-<time>-seed<N>)")
     parser.add_argument("--json", action="store_true",
                         help="print the summary as one JSON object on stdout")
@@ -159,6 +159,7 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> 
     task = progress.add_task("flight", total=opts.duration_s)
     if opts.run_dir is None:
         opts.run_dir = launch_options.new_run_dir(opts.kind, opts.seed)
+    outdir.usable_dir(Path(opts.run_dir), "--run-dir")
     wanted = fault_plan.requested(opts)
     judging = bool(wanted) and opts.judge
     if judging:

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -31,11 +32,18 @@ def _write(path: Path, text: str) -> int:
     """Writes `text` unless the file already holds it (an unchanged header keeps its time, so
     the build does not recompile what includes it)."""
     data = text.encode("utf-8")
+    if path.is_symlink() or path.parent.is_symlink():
+        raise ImaError(f"{path if path.is_symlink() else path.parent}: a symbolic link: "
+                       "ima deploy writes no file through one", exit_code=2)
     try:
         if path.is_file() and path.read_bytes() == data:
             return text.count("\n")
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_bytes(data)
+        # O_NOFOLLOW: a link put there meanwhile is refused, not written through
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW | os.O_CLOEXEC,
+                     0o644)
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
     except OSError as exc:
         raise ImaError(f"{path}: cannot write: {exc.strerror or exc}") from exc
     return text.count("\n")
@@ -45,10 +53,11 @@ def _remove_stale(out_dir: Path, keep: set[Path]) -> None:
     """Deletes files an earlier `ima deploy` wrote to out_dir that this one does not (a node
     no longer in the system, a partition renamed); any other file is left alone."""
     candidates = [(p, _MARK_XML) for p in out_dir.glob("*.xml")]
-    candidates += [(p, _MARK_C) for p in (out_dir / GLUE_DIR).glob("*.h")]
+    if not (out_dir / GLUE_DIR).is_symlink():
+        candidates += [(p, _MARK_C) for p in (out_dir / GLUE_DIR).glob("*.h")]
     for path, mark in candidates:
-        if path in keep or not path.is_file():
-            continue
+        if path in keep or path.is_symlink() or not path.is_file():
+            continue  # (a link is not a file ima deploy wrote, whatever it points to)
         try:
             with path.open(encoding="utf-8") as f:
                 first = f.readline()

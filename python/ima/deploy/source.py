@@ -12,6 +12,7 @@ from typing import Any
 
 import yaml
 
+from ima import yamlfile
 from ima.deploy.locate import Locator, path_text
 from ima.deploy.model import SystemModelError
 
@@ -54,9 +55,6 @@ class Source:
         return sorted({f.path.resolve() for f in self.owners.values()} - {self.main.path.resolve()})
 
 
-_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-
-
 def _read(path: Path) -> _File:
     if not path.is_file():
         raise SystemModelError(f"{path}: no such system file")
@@ -66,13 +64,11 @@ def _read(path: Path) -> _File:
         raise SystemModelError(f"{path}: cannot read: {exc}") from exc
     try:
         # Parsed once (libyaml's parser when PyYAML has it): the nodes keep the lines that
-        # errors name, and the document is constructed from them.
-        loader = _LOADER(text)
-        try:
-            root = loader.get_single_node()
-            doc = loader.construct_document(root) if root is not None else None
-        finally:
-            loader.dispose()
+        # errors name, and the document is constructed from them, within yamlfile's bounds.
+        root = yamlfile.compose(text)
+        doc = yamlfile.construct(root)
+    except yamlfile.YamlLimitError as exc:
+        raise SystemModelError(f"{path}: refused: {exc}") from exc
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"{path}:{mark.line + 1}" if mark else str(path)

@@ -11,6 +11,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ima.errors import ImaError
+
 DEFAULT_SETTLE_S = 60.0
 MODE_NAMES = {0: "INIT", 1: "DIRECT", 2: "AUTOPILOT", 3: "MISSION", 4: "CONTINGENCY"}
 FALLBACK_NAMES = {0: "NONE", 1: "C2_LOST", 2: "MISSION_STALE", 3: "NAV_INVALID", 4: "NO_TARGETS",
@@ -182,7 +184,21 @@ def summarise(run_dir: Path, pilot: Path, duration_s: float, wall_s: float | Non
     if plot and truth:
         from ima.flight.plot import plot_flight
 
-        summary["plot"] = str(plot_flight(truth, segments, run_dir / "flight.png",
-                                          f"{pilot.name}, {run_dir.name}", events))
-    (run_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+        try:
+            summary["plot"] = str(plot_flight(truth, segments, run_dir / "flight.png",
+                                              f"{pilot.name}, {run_dir.name}", events))
+        except OSError as exc:  # a full disk: the summary says so, the run is not lost
+            summary["plot"] = None
+            summary["plot_error"] = f"{run_dir / 'flight.png'}: {exc.strerror}"
+    write_summary(run_dir, summary)
     return summary
+
+
+def write_summary(run_dir: Path, summary: dict) -> None:
+    """RUN_DIR/summary.json; ImaError when it cannot be written (the traces stay)."""
+    path = run_dir / "summary.json"
+    try:
+        path.write_text(json.dumps(summary, indent=2) + "\n")
+    except OSError as exc:
+        raise ImaError(f"cannot write {path}: {exc.strerror} (the run's traces are in "
+                       f"{run_dir})") from exc

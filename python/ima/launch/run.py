@@ -30,6 +30,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from ima import outdir
 from ima.deploy.model import canbus_socket_name, dds_socket_name
 from ima.errors import ImaError
 from ima.launch import commands, procs
@@ -68,7 +69,7 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None,
     pilot_script.load(pilot)  # a bad script is reported before anything starts
 
     run_dir = Path(opts.run_dir) if opts.run_dir else new_run_dir(opts.kind, opts.seed)
-    run_dir.mkdir(parents=True, exist_ok=True)
+    outdir.usable_dir(run_dir, "run directory")
     run_dir = run_dir.resolve()  # the nodes run in the socket directory: paths are absolute
     plan = fault_plan.prepare(opts, system, run_dir, launch)
     kills, hangs = plan.kills, plan.hangs

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from ima.flight import summary as flight_summary
-from ima.flight.summary import read_jsonl
+from ima.flight.summary import read_jsonl, write_summary
 
 MEMBERSHIP_PREFIX = "membership "
 MONITOR_PREFIX = "cross-channel monitor: "
@@ -104,4 +104,4 @@ def summarise(run_dir: Path, pilot: Path, duration_s: float, nodes: list[str],
 
 def write(run_dir: Path, summary: dict) -> None:
     """RUN_DIR/summary.json."""
-    (run_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    write_summary(run_dir, summary)

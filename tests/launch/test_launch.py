@@ -130,6 +130,10 @@ def test_ctrl_c_stops_everything(tmp_path):
     assert _run_pids(str(run_dir)) == {}, "processes left behind"
     summary = json.loads(out)
     assert 0 < summary["flown_s"] < 600 and summary["nodes"] == ["node1", "node2", "node3"]
+    # the summary says the run was cut short, and when; so does summary.json
+    assert summary["interrupted"] is True and summary["interrupted_at_s"] == summary["flown_s"]
+    assert json.loads((run_dir / "summary.json").read_text())["interrupted"] is True
+    assert summary["vote_status"] is not None  # the world recorded the run up to the stop
 
 
 @pytest.mark.parametrize("args,message", [

@@ -72,6 +72,7 @@ def test_run_module_passes_options_and_returns_stats(fake_ske, module_xml, sampl
         "node2",
         "--seed",
         "3",
+        "--",  # a module path that starts with '-' is no option
         str(module_xml),
     ]
 

@@ -180,8 +180,12 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> 
                                        result.killed, result.wall_s, plot=True,
                                        hung=result.hung)
     summary["returncodes"] = result.returncodes
+    # Ctrl-C (or SIGTERM): the run ended early, at the last emulated time the world recorded
+    summary["interrupted"] = bool(result.interrupted)
+    summary["interrupted_at_s"] = summary.get("flown_s") if result.interrupted else None
     summary["dds_domain"] = result.domain
     summary["provenance"] = provenance.provenance()
+    launch_summary.write(result.run_dir, summary)
     if result.plan is not None:
         summary["faults"] = [{"id": f.fid, "spec": f.spec(), "class": f.cls,
                               "t_s": f.trigger.at_s, "applied": None} for f in result.plan.faults]

@@ -57,6 +57,11 @@ def print_redundancy(s: dict, console) -> None:
 
 
 def print_summary(s: dict, console) -> None:
+    if s.get("interrupted"):
+        at = s.get("interrupted_at_s")
+        console.print("[bold yellow]Interrupted[/] (Ctrl-C)" +
+                      (f" at {at:g} s of emulated time" if at is not None else "") +
+                      ": what follows is the run up to there")
     print_flight(s, console)
     if len(s.get("nodes", [])) > 1:
         print_redundancy(s, console)

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ima import paths
+from ima.errors import ImaError
 
 # pytest's documented exit codes (pytest.ExitCode), without importing pytest here.
 _PYTEST_EXIT = {
@@ -110,6 +111,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     only = parser.add_mutually_exclusive_group()
     only.add_argument("--unit-only", action="store_true", help="run ctest only")
     only.add_argument("--py-only", action="store_true", help="run pytest only")
+    only.add_argument(
+        "--fuzz-long", nargs="?", type=int, const=FUZZ_LONG, default=None, metavar="N",
+        help=f"only the fuzzing of the inputs, with N inputs (default {FUZZ_LONG:,}; the "
+        "suite's share is 400); its counts go to build/fuzz-long.json")
     parser.add_argument(
         "--no-sanitize",
         action="store_true",
@@ -163,8 +168,28 @@ def _run_pytest(root: Path, keyword: str | None) -> Outcome:
     return outcome
 
 
+FUZZ_LONG = 10_000
+
+
+def _run_fuzz_long(root: Path, count: int) -> int:
+    """tests/fuzz with `count` inputs; prints and keeps its counts."""
+    report = paths.build_dir() / "fuzz-long.json"
+    env = dict(os.environ, IMA_FUZZ_COUNT=str(count), IMA_FUZZ_REPORT=str(report))
+    report.unlink(missing_ok=True)
+    cmd = pytest_command(sys.executable, paths.tests_dir() / "fuzz", None, env) + ["-s"]
+    outcome = pytest_outcome(subprocess.run(cmd, cwd=root, env=env).returncode)
+    if report.is_file():
+        print(f"ima: fuzzing counts in {report}: {report.read_text().strip()}")
+    print(Outcome("pytest (fuzz)", outcome.ok, outcome.reason))
+    return 0 if outcome.ok else 1
+
+
 def run(args: argparse.Namespace) -> int:
     root = paths.repo_root()
+    if args.fuzz_long is not None:
+        if args.fuzz_long < 1:
+            raise ImaError("--fuzz-long N: at least one input", exit_code=2)
+        return _run_fuzz_long(root, args.fuzz_long)
     outcomes = []
     if not args.py_only:
         outcomes.append(_run_ctest(root, paths.build_dir()))

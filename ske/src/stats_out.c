@@ -85,7 +85,10 @@ int ske__write_stats(ske_t *s, double wall_s)
             fprintf(f, "\"%s\"", sig);
         else
             fputs("null", f);
-        fprintf(f, ",\"cpu_outside_windows_ns_max\":%" PRId64 "}", p->cpu_outside_max_ns);
+        fprintf(f, ",\"cpu_outside_windows_ns_max\":%" PRId64, p->cpu_outside_max_ns);
+        if (p->cfg->hm_log_port >= 0) /* HM decisions its full HM log port could not take */
+            fprintf(f, ",\"hm_log_lost\":%llu", (unsigned long long)p->hm_log_lost);
+        fputc('}', f);
     }
     fprintf(f, "],\"hm_events\":%llu", (unsigned long long)s->hm_events);
     fputs(",\"windows\":", f);

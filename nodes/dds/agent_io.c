@@ -46,7 +46,9 @@ int agent_io_listen(agent_t *a)
         unlink(path);
     }
     int fd = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
-    if (fd < 0 || bind(fd, (struct sockaddr *)&sa, sizeof sa) != 0 || listen(fd, 4) != 0) {
+    /* 0600: only the run's owner may connect (checked again at accept) */
+    if (fd < 0 || bind(fd, (struct sockaddr *)&sa, sizeof sa) != 0 ||
+        chmod(path, S_IRUSR | S_IWUSR) != 0 || listen(fd, 4) != 0) {
         fprintf(stderr, "ima-dds-node %s: cannot listen at %s: %s\n", a->node_name, path,
                 strerror(errno));
         if (fd >= 0)
@@ -62,6 +64,13 @@ void agent_io_accept(agent_t *a)
     int fd = accept4(a->listen_fd, NULL, NULL, SOCK_CLOEXEC | SOCK_NONBLOCK);
     if (fd < 0)
         return; /* EAGAIN, or the peer gave up already */
+    struct ucred cred;
+    socklen_t len = sizeof cred;
+    if (getsockopt(fd, SOL_SOCKET, SO_PEERCRED, &cred, &len) != 0 || cred.uid != getuid()) {
+        close(fd); /* only the run's owner's io may use its agent */
+        agent_trace_simple(a, "io_refused_user");
+        return;
+    }
     a->io_fd = fd;
     a->io_hello = false;
     a->io_connections++;

@@ -163,6 +163,13 @@ static void accept_all(canbus_bus_t *b)
         int fd = accept4(b->listen_fd, NULL, NULL, SOCK_NONBLOCK | SOCK_CLOEXEC);
         if (fd < 0)
             return; /* EAGAIN, or a transient error: the next poll tells */
+        struct ucred cred;
+        socklen_t len = sizeof cred;
+        if (getsockopt(fd, SOL_SOCKET, SO_PEERCRED, &cred, &len) != 0 || cred.uid != getuid()) {
+            b->refused_users++; /* only the run's owner may use its bus */
+            close(fd);
+            continue;
+        }
         if (b->n_live >= (size_t)b->o.max_clients + 32) {
             close(fd); /* connections that never say hello */
             continue;
@@ -188,10 +195,7 @@ static void accept_all(canbus_bus_t *b)
         }
         c->fd = fd;
         c->index = -1;
-        struct ucred cred;
-        socklen_t len = sizeof cred;
-        if (getsockopt(fd, SOL_SOCKET, SO_PEERCRED, &cred, &len) == 0)
-            c->pid = cred.pid;
+        c->pid = cred.pid;
         b->live[b->n_live++] = c;
     }
 }

@@ -65,7 +65,9 @@ int canbus_bus_open(canbus_bus_t *b, const canbus_opts_t *o)
             close(probe);
         unlink(o->socket_path);
     }
-    if (bind(b->listen_fd, (struct sockaddr *)&sa, sizeof sa) || listen(b->listen_fd, 128)) {
+    /* 0600: only the run's owner may connect (who does is checked again at accept) */
+    if (bind(b->listen_fd, (struct sockaddr *)&sa, sizeof sa) ||
+        chmod(o->socket_path, S_IRUSR | S_IWUSR) || listen(b->listen_fd, 128)) {
         rc = -errno;
         goto fail_sock;
     }
@@ -103,12 +105,13 @@ int canbus_bus_write_stats(canbus_bus_t *b, const char *path)
             ",\"duplicated\":%" PRIu64 ",\"rx_dropped\":%" PRIu64 ",\"rejected\":%" PRIu64 ",\"bad_hellos\":%" PRIu64 ",\"late_joins\":%" PRIu64
             ",\"refused_full\":%" PRIu64 ",\"send_timeouts\":%" PRIu64
             ",\"garbage_disconnects\":%" PRIu64 ",\"faults_armed\":%" PRIu64
+            ",\"refused_users\":%" PRIu64
             ",\"wall_s\":%.6f,\"frames_per_wall_s\":%.1f,\"release_late_max_us\":%.1f"
             ",\"quanta_late\":%" PRIu64 ",\"stop\":\"%s\",\"clients\":[",
             b->o.bitrate, b->o.quantum_ns, b->quanta, b->t, w->frames, w->frame_bits,
             w->busy_bits, canbus_wire_bit_ns(w, w->busy_bits), load, max1, w->error_frames,
             w->bus_off_events, w->dropped, w->duplicated, w->rx_dropped, b->rejected, b->bad_hellos, b->late_joins, b->full,
-            b->send_timeouts, b->garbage_kicks, b->faults_armed + b->o.n_faults, wall,
+            b->send_timeouts, b->garbage_kicks, b->faults_armed + b->o.n_faults, b->refused_users, wall,
             wall > 0 ? (double)w->frames / wall : 0.0, (double)b->late_max_ns / 1e3, b->quanta_late,
             canbus__stop_name(b->stop_reason));
     for (int i = 0; i < b->next_index; i++) {

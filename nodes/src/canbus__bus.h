@@ -121,6 +121,7 @@ typedef struct canbus_bus {
     uint8_t *rxbuf;
     uint64_t quanta, rejected, bad_hellos, late_joins, full, send_timeouts, garbage_kicks;
     uint64_t faults_armed;
+    uint64_t refused_users; /* connections of another user, closed at once */
     bool trace_error;
 } canbus_bus_t;
 

@@ -98,12 +98,13 @@ def new_run_dir(kind: str, seed: int) -> Path:
 
 
 def socket_dir(run_dir: Path) -> tuple[Path, Path | None]:
-    """The directory of the run's Unix sockets: the run directory when the longest socket path
-    fits an address, else a fresh temporary directory (returned second, to remove at the end).
-    Every node's ima-ske runs in it, so the module's socket paths are relative to it."""
-    if len(os.fsencode(run_dir / "dds3.sock")) < _SOCKET_PATH_MAX:
-        return run_dir, None
+    """The directory of the run's Unix sockets: a fresh one of its own in the temporary folder,
+    which only the run's owner may enter (0700: nobody else can reach the bus or the agents),
+    returned twice (the second to remove at the end). Every node's ima-ske runs in it, so the
+    module's socket paths are relative to it; RUN_DIR/can.sock links to the bus's socket for
+    the tools that watch a run (the link leads nobody else in)."""
     tmp = Path(tempfile.mkdtemp(prefix="ima-run-"))
+    os.chmod(tmp, 0o700)
     return tmp, tmp
 
 

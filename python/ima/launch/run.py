@@ -140,6 +140,7 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
             netns.create()
         ps.start("canbus", procs_plan.bus)
         procs.wait_for_socket(procs_plan.bus_socket, ps)
+        _link(run_dir / canbus_socket_name(), procs_plan.bus_socket)
         agents = {}
         for name, cmd in procs_plan.agents.items():
             node = name.split("/")[0]
@@ -182,6 +183,8 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
             signal.signal(s, h)
         for name in [canbus_socket_name(), *(dds_socket_name(n.index) for n in system.nodes)]:
             (sock_dir / name).unlink(missing_ok=True)
+        if (run_dir / canbus_socket_name()).is_symlink():
+            (run_dir / canbus_socket_name()).unlink()
         if sock_tmp is not None:
             shutil.rmtree(sock_tmp, ignore_errors=True)
     wall = time.monotonic() - t0
@@ -192,6 +195,18 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
     return LaunchRun(run_dir=run_dir, nodes=names, returncodes=ps.returncodes(), wall_s=wall,
                      interrupted=interrupted, killed=killed, domain=domain, hung=hung,
                      plan=plan if plan.faults else None)
+
+
+def _link(link: Path, target: Path) -> None:
+    """RUN_DIR/can.sock, a link to the bus's socket in the run's private socket directory."""
+    if link == target:
+        return
+    try:
+        if link.is_symlink():
+            link.unlink()
+        link.symlink_to(target)
+    except OSError:
+        pass  # a tool then finds the socket from launch.json's `socket`
 
 
 def _watching(on_status: Callable[[dict], None] | None, stop_when: Callable[[dict], bool] | None,

@@ -160,16 +160,8 @@ def _fuzz_pilot(rng, k, work, cwd, tally, seeds):
     tally.counts["valid_pilot"] += valid
     if wrong:
         tally.problem("pilot", k, wrong, path)
-    if not valid or rng.random() >= FLY["pilot"]:
-        return
-    run_dir = work / f"pilot-{k}-run"
-    p = _run([str(ROOT / "ima"), "fly", "--duration", "1.2", "--pilot", str(path), "--run-dir",
-              str(run_dir), "--json"], cwd)
-    wrong = _judge_process(p, {0, 1, 2})
-    if wrong:
-        tally.problem("pilot-flight", k, wrong, path)
-    elif p.returncode == 0 and json.loads(p.stdout).get("flown_s", 0) >= 1.0:
-        tally.counts["ran"] += 1
+    if valid and rng.random() < FLY["pilot"]:
+        _fly(["fly", "--pilot", str(path)], "pilot", k, path, work, cwd, tally)
 
 
 def _fuzz_system(rng, k, work, cwd, tally, seeds):
@@ -185,13 +177,17 @@ def _fuzz_system(rng, k, work, cwd, tally, seeds):
     tally.counts["valid_system"] += valid
     if wrong:
         tally.problem("system", k, wrong, path)
-    if not valid or rng.random() >= FLY["system"]:
-        return
-    p = _run([str(ROOT / "ima"), "launch", str(path), "--duration", "1.2", "--run-dir",
-              str(work / f"system-{k}-run"), "--json"], cwd)
+    if valid and rng.random() < FLY["system"]:
+        _fly(["launch", str(path)], "system", k, path, work, cwd, tally)
+
+
+def _fly(args: list[str], kind: str, k: int, path: Path, work: Path, cwd: Path, tally) -> None:
+    """A valid input flown 1.2 s (20 major frames and more): `ima fly` or `ima launch`."""
+    p = _run([str(ROOT / "ima"), *args, "--duration", "1.2", "--run-dir",
+              str(work / f"{kind}-{k}-run"), "--json"], cwd)
     wrong = _judge_process(p, {0, 1, 2})
     if wrong:
-        tally.problem("system-flight", k, wrong, path)
+        tally.problem(f"{kind}-flight", k, wrong, path)
     elif p.returncode == 0 and json.loads(p.stdout).get("flown_s", 0) >= 1.0:
         tally.counts["ran"] += 1
 

@@ -29,6 +29,18 @@ void ske__diag_set(ske_diag_t *d, const char *file, int line, const char *elemen
     va_start(ap, fmt);
     vsnprintf(d->message, sizeof d->message, fmt, ap);
     va_end(ap);
+    /* One line, whatever the message quotes of the file (libxml2 quotes the input around
+     * an error, newlines and all): control characters become single spaces. */
+    char *out = d->message;
+    for (const char *in = d->message; *in; in++) {
+        bool blank = (unsigned char)*in < 0x20 || *in == 0x7f;
+        if (blank && (out == d->message || out[-1] == ' '))
+            continue;
+        *out++ = blank ? ' ' : *in;
+    }
+    while (out > d->message && out[-1] == ' ')
+        out--;
+    *out = '\0';
 }
 
 void ske_diag_format(const ske_diag_t *d, char *buf, size_t len)

@@ -656,3 +656,13 @@ def test_a_module_name_is_1_to_63_characters(check, example, name, says):
     bad = example.replace('ModuleName="three_partitions"', f'ModuleName="{name}"')
     refused(check, bad, at=bad.tag("<ARINC_653_Module"), element="ARINC_653_Module",
             rule="a module name of 1 to 63 characters", says=(says,))
+
+
+def test_a_parse_error_that_quotes_the_file_is_still_one_line(check, example):
+    """libxml2 quotes the input around some errors, newlines and all (found by tests/fuzz)."""
+    text = example.text
+    cut = text.index("<Module_Schedule")
+    bad = Module(text[:cut] + "<![CDATA[\n" + text[cut:])
+    path, r = check(bad)
+    assert r.returncode == EXIT_INVALID_MODULE and len(r.stderr.splitlines()) == 1, r.stderr
+    assert "CData section not finished" in r.stderr and "(rule: well-formed XML)" in r.stderr

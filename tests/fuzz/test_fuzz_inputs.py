@@ -92,6 +92,16 @@ def _in_process(call, expected=(ImaError,)) -> tuple[bool, str | None]:
     return True, None
 
 
+def _read(kind: str, k: int, path: Path, call, tally: Tally) -> bool:
+    """An input read in this process: counted, its problem kept; whether it is valid."""
+    valid, wrong = _in_process(call)
+    tally.counts[kind] += 1
+    tally.counts[f"valid_{kind}"] += valid
+    if wrong:
+        tally.problem(kind, k, wrong, path)
+    return valid
+
+
 def _flat(system: Path) -> dict:
     src = read_source(system)
     doc = json.loads(json.dumps(src.doc, default=str))
@@ -155,11 +165,7 @@ def _fuzz_pilot(rng, k, work, cwd, tally, seeds):
         return
     path = work / f"pilot-{k}.yaml"
     path.write_text(new, encoding="utf-8", errors="surrogatepass")
-    valid, wrong = _in_process(lambda: pilot_script.load(path))
-    tally.counts["pilot"] += 1
-    tally.counts["valid_pilot"] += valid
-    if wrong:
-        tally.problem("pilot", k, wrong, path)
+    valid = _read("pilot", k, path, lambda: pilot_script.load(path), tally)
     if valid and rng.random() < FLY["pilot"]:
         _fly(["fly", "--pilot", str(path)], "pilot", k, path, work, cwd, tally)
 
@@ -172,11 +178,7 @@ def _fuzz_system(rng, k, work, cwd, tally, seeds):
     path = work / f"system-{k}.yaml"
     path.write_text(yaml.safe_dump(new, sort_keys=False, allow_unicode=True), encoding="utf-8")
     out = work / f"system-{k}-deploy"
-    valid, wrong = _in_process(lambda: generate(load_system(path), out))
-    tally.counts["system"] += 1
-    tally.counts["valid_system"] += valid
-    if wrong:
-        tally.problem("system", k, wrong, path)
+    valid = _read("system", k, path, lambda: generate(load_system(path), out), tally)
     if valid and rng.random() < FLY["system"]:
         _fly(["launch", str(path)], "system", k, path, work, cwd, tally)
 
@@ -199,11 +201,7 @@ def _fuzz_campaign(rng, k, work, cwd, tally, seeds):
         else mutate.mutate_text(rng, text)
     path = work / f"campaign-{k}.yaml"
     path.write_text(new, encoding="utf-8", errors="surrogatepass")
-    valid, wrong = _in_process(lambda: campaign_spec.load(path))
-    tally.counts["campaign"] += 1
-    tally.counts["valid_campaign"] += valid
-    if wrong:
-        tally.problem("campaign", k, wrong, path)
+    _read("campaign", k, path, lambda: campaign_spec.load(path), tally)
 
 
 @pytest.mark.skipif(not SKE.is_file(), reason="ima-ske is not built")

@@ -435,15 +435,18 @@ class RunTraces:
     @functools.cached_property
     def dds(self) -> dict[str, list[dict]]:
         """Each agent's trace up to the end of the run: what it saw of the run. At the end the
-        agents are stopped one by one, and those stopped later see the first ones go
-        (`dds_peer_lost`, writer gone): every trace is cut where the first agent was stopped
-        (the wall-clock time of the first `dds_stop` of the run's last frame), each at its
-        own `dds_stop` at the latest."""
+        nodes stop, then the agents one by one: those stopped later see the first ones go
+        (`dds_peer_lost`, writer gone), and on a loaded host the agents may idle past their
+        liveliness lease between the two (`dds_peer_lost`, liveliness). Every trace is cut
+        where the run ended for the first agent (the wall-clock time of the first
+        `io_disconnect` or `dds_stop` of the run's last frame), each at its own `dds_stop` at
+        the latest."""
         traces = {n: read_jsonl(self.run_dir / f"dds{k}.jsonl")
                   for k, n in enumerate(self.nodes, start=1)}
         last = max((e.get("t_ns", 0) for events in traces.values() for e in events), default=0)
         ends = [e["t_wall_ns"] for events in traces.values() for e in events
-                if e.get("kind") == "dds_stop" and isinstance(e.get("t_wall_ns"), int)
+                if e.get("kind") in ("dds_stop", "io_disconnect")
+                and isinstance(e.get("t_wall_ns"), int)
                 and e.get("t_ns", 0) >= last - 50_000_000]
         first_stop = min(ends, default=None)
         out = {}

@@ -20,11 +20,14 @@ static void usage(FILE *f)
           "                    [--realtime] [--xch-timeout-us 2000] [--lease-ms 1000]\n"
           "                    [--deadline-ms 150] [--startup-timeout-ms 20000]\n"
           "                    [--bind-device lo] [--trace FILE] [--stats FILE]\n"
-          "                    [--fault SPEC]... [-q]\n"
+          "                    [--security DIR] [--fault SPEC]... [-q]\n"
           "  --config FILE  Cyclone DDS configuration (default: $IMA_DDS_CONFIG; the shipped\n"
           "                 one is config/dds/cyclonedds-loopback.xml)\n"
           "  --bind-device  interface every DDS socket is bound to (\"\" leaves them as\n"
           "                 Cyclone made them)\n"
+          "  --security DIR the run's DDS Security files (ima launch makes them): identity\n"
+          "                 and permissions CAs, nodeK.pem/.key, governance.p7s,\n"
+          "                 permissions.p7s; without it the agent runs without security\n"
           "  --fault SPEC   dds_drop:fid=ID,at=TIME[,until=TIME][,period=TIME,on=TIME] or\n"
           "                 dds_delay:...,frames=N: this node's inputs and health are not\n"
           "                 published, or published N major frames late (faultinject/README.md)\n",
@@ -44,7 +47,8 @@ static bool parse_i64(const char *s, int64_t lo, int64_t hi, int64_t *out)
 
 enum {
     OPT_NODE = 256, OPT_NODES, OPT_SOCKET, OPT_DOMAIN, OPT_CONFIG, OPT_REALTIME, OPT_XCH_TIMEOUT,
-    OPT_LEASE, OPT_DEADLINE, OPT_STARTUP, OPT_BIND, OPT_TRACE, OPT_STATS, OPT_FAULT, OPT_HELP,
+    OPT_LEASE, OPT_DEADLINE, OPT_STARTUP, OPT_BIND, OPT_TRACE, OPT_STATS, OPT_FAULT, OPT_SECURITY,
+    OPT_HELP,
 };
 
 static int parse_args(int argc, char **argv, agent_opts_t *o, dds_faults_t *faults)
@@ -64,6 +68,7 @@ static int parse_args(int argc, char **argv, agent_opts_t *o, dds_faults_t *faul
         {"trace", required_argument, NULL, OPT_TRACE},
         {"stats", required_argument, NULL, OPT_STATS},
         {"fault", required_argument, NULL, OPT_FAULT},
+        {"security", required_argument, NULL, OPT_SECURITY},
         {"help", no_argument, NULL, OPT_HELP},
         {NULL, 0, NULL, 0},
     };
@@ -129,6 +134,11 @@ static int parse_args(int argc, char **argv, agent_opts_t *o, dds_faults_t *faul
             break;
         case OPT_STATS:
             o->stats_path = optarg;
+            break;
+        case OPT_SECURITY:
+            if (!*optarg || strlen(optarg) > PATH_MAX - 32)
+                bad = "--security wants a directory";
+            o->security_dir = optarg;
             break;
         case OPT_FAULT:
             if (dds_fault_add(faults, optarg, why, sizeof why) != 0)
@@ -413,6 +423,7 @@ out_dds:
     agent_io_shutdown(a);
     /* Deleting the participant waits for running listeners: they must not wait for us. */
     a->answer_in_listener = false;
+    agent_dds_census(a);
     pthread_mutex_unlock(&a->state);
     agent_dds_stop(a);
     pthread_mutex_lock(&a->state);

@@ -37,6 +37,7 @@ typedef struct {
     int64_t deadline_ns;       /* NodeHealth deadline */
     int64_t startup_timeout_ns;/* how long to wait for the other agents at startup */
     const char *bind_device;   /* interface the DDS sockets are bound to ("" = leave them) */
+    const char *security_dir;  /* the run's DDS Security files (NULL: no security) */
     const char *trace_path, *stats_path;
     bool quiet;
 } agent_opts_t;
@@ -55,12 +56,29 @@ typedef struct {
 #define AGENT_EV_QUEUE 1024
 #define AGENT_MAX_WRITERS 64 /* remote writers remembered (handle -> node) */
 
+/* A remote writer, and the node it publishes for: the one whose DDS partition it writes in
+ * (only node K's identity may write in partition "nodeK" when security is on). */
 typedef struct {
     dds_instance_handle_t handle;
     int topic;
-    unsigned node;       /* 0 unknown (not an agent of this run) */
-    bool matched;
+    unsigned node;       /* 0 unknown (not in one node's partition of this run) */
+    bool known;          /* its partition was looked up */
+    bool matched, alive;
+    uint64_t refused;    /* samples it wrote under another node's key, or outside the nodes */
+    unsigned claimed;    /* the node key of the latest one */
+    char partition[24];  /* for the report ("" when it writes in several or none) */
+    dds_guid_t participant;
 } agent_writer_t;
+
+/* A participant of the run's domain that is neither this agent nor another node's agent
+ * (agent_dds_census): a tool, or an intruder. */
+#define AGENT_MAX_FOREIGN 16
+typedef struct {
+    dds_guid_t guid;
+    char process[32];  /* its __ProcessName property, JSON-safe ("" unknown) */
+    long pid;          /* its __Pid property (0 unknown) */
+    bool refused;      /* it wrote samples this agent refused */
+} agent_foreign_t;
 
 typedef struct {
     bool discovered;     /* its inputs writer was matched at least once */
@@ -112,7 +130,10 @@ struct agent {
     char node_name[16];
 
     /* DDS */
-    dds_entity_t pp, tp[T_COUNT], rd[T_COUNT], wr[T_COUNT];
+    dds_entity_t pp, pub, sub, tp[T_COUNT], rd[T_COUNT], wr[T_COUNT];
+    dds_entity_t rd_participants; /* the built-in topic: who else joined the domain */
+    agent_foreign_t foreign[AGENT_MAX_FOREIGN];
+    int n_foreign;
     agent_rd_ctx_t rd_ctx[T_COUNT];
     agent_writer_t writers[AGENT_MAX_WRITERS];
     int n_writers;
@@ -158,6 +179,7 @@ struct agent {
     /* statistics */
     agent_topic_stats_t ts[T_COUNT];
     uint64_t agreed, waits, timeouts, superseded, bad_datagrams, partial;
+    uint64_t refused_samples;  /* from writers that are not the node of the sample's key */
     uint64_t deadline_paused;  /* lockstep: deadline misses while this node was paused too */
     agent_lat_t xch_lat;       /* io's request to its AGREED */
     agent_lat_t dds_lat;       /* a peer's dds_write of its inputs to their take here */
@@ -179,6 +201,9 @@ void agent_lat_free(agent_lat_t *l);
 void agent_wake(agent_t *a);
 int agent_dds_start(agent_t *a);
 void agent_dds_stop(agent_t *a);
+/* Before agent_dds_stop: the participants that joined the domain and are not the nodes'
+ * agents, into a->foreign. */
+void agent_dds_census(agent_t *a);
 void agent_dds_process_events(agent_t *a);
 void agent_dds_take_all(agent_t *a);
 bool agent_dds_discovery_complete(agent_t *a, uint32_t *missing);
@@ -188,6 +213,26 @@ unsigned agent_dds_bind_sockets(agent_t *a);
 /* Emulated time: latches as hung the peers of `missing` that are silent (see agent_dds.c);
  * true if it did any. */
 bool agent_dds_declare_hung(agent_t *a, uint32_t missing);
+
+/* agent_writers.c: the other participants (see there). */
+/* The DDS partition node K's agent publishes in; readers take a writer's node from it. */
+#define AGENT_PARTITION_FMT "node%u"
+agent_writer_t *agent_writer_find(agent_t *a, int topic, dds_instance_handle_t h);
+/* The writer of handle on topic, its partition looked up once while it is matched; NULL if
+ * unknown. */
+agent_writer_t *agent_writer_of(agent_t *a, int topic, dds_instance_handle_t h);
+/* Whether node k has a writer of topic matched (alive, if `alive`) other than `except`. */
+bool agent_node_has_writer(agent_t *a, int topic, unsigned k, bool alive,
+                           const agent_writer_t *except);
+/* Whether a sample keyed as node k comes from a writer in node k's partition; if not, it is
+ * refused: counted on its writer and traced at its first (dds_refused). */
+bool agent_from_node(agent_t *a, int t, dds_instance_handle_t h, unsigned k);
+
+extern const char *const agent_topic_name[T_COUNT];
+
+/* agent_security.c: the participant's QoS, with the DDS Security properties when
+ * --security is given; NULL (reported) if its files or Cyclone's plugins are missing. */
+dds_qos_t *agent_security_qos(agent_t *a);
 
 /* agent_io.c */
 int agent_io_listen(agent_t *a);

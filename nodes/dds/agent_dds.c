@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The DDS side of the agent: participant, topics, QoS, listeners, peers' liveliness, samples. */
+#include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
 #include <inttypes.h>
@@ -12,15 +13,12 @@
 #include "agent__agent.h"
 #include "rpas.h"
 
-static const char *const topic_name[T_COUNT] = {"rpas_CrossChannelInputs", "rpas_NodeHealth",
+const char *const agent_topic_name[T_COUNT] = {"rpas_CrossChannelInputs", "rpas_NodeHealth",
                                                  "rpas_Telemetry", "rpas_MissionData"};
 static const dds_topic_descriptor_t *const topic_desc[T_COUNT] = {
     &rpas_CrossChannelInputs_desc, &rpas_NodeHealth_desc, &rpas_Telemetry_desc,
     &rpas_MissionData_desc};
 
-/* Every endpoint of an agent carries this in its USER_DATA, so that a peer can tell which
- * node a matched writer belongs to before it has published anything. */
-#define UDATA_FMT "ima-node=%u"
 
 /* ---- listeners: Cyclone's threads ------------------------------------------------------ */
 
@@ -119,9 +117,6 @@ static dds_qos_t *endpoint_qos(const agent_t *a, int topic, bool writer)
     dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, a->o.lease_ns);
     if (topic == T_HEALTH)
         dds_qset_deadline(q, a->o.deadline_ns);
-    char ud[32];
-    int n = snprintf(ud, sizeof ud, UDATA_FMT, a->o.node);
-    dds_qset_userdata(q, ud, (size_t)n);
     if (writer) {
         /* Deleting a writer (the agent exits or dies) leaves its instance "no writers", which
          * readers take as the node's loss; disposal is kept for "io link down". */
@@ -132,19 +127,50 @@ static dds_qos_t *endpoint_qos(const agent_t *a, int topic, bool writer)
     return q;
 }
 
-int agent_dds_start(agent_t *a)
+/* The publisher writes in this node's partition, the subscriber reads every node's. */
+static int create_pub_sub(agent_t *a)
 {
-    a->pp = dds_create_participant((dds_domainid_t)a->o.domain, NULL, NULL);
-    if (a->pp < 0) {
-        fprintf(stderr, "ima-dds-node %s: cannot create the DDS participant on domain %u: %s\n",
-                a->node_name, a->o.domain, dds_strretcode(a->pp));
+    char own[24], names[XCH_MAX_NODES][24];
+    const char *all[XCH_MAX_NODES];
+    snprintf(own, sizeof own, AGENT_PARTITION_FMT, a->o.node);
+    for (unsigned k = 1; k <= a->o.nodes; k++) {
+        snprintf(names[k - 1], sizeof names[k - 1], AGENT_PARTITION_FMT, k);
+        all[k - 1] = names[k - 1];
+    }
+    dds_qos_t *q = dds_create_qos();
+    dds_qset_partition1(q, own);
+    a->pub = dds_create_publisher(a->pp, q, NULL);
+    dds_qset_partition(q, a->o.nodes, all);
+    a->sub = dds_create_subscriber(a->pp, q, NULL);
+    dds_delete_qos(q);
+    if (a->pub < 0 || a->sub < 0) {
+        fprintf(stderr, "ima-dds-node %s: cannot create the publisher or subscriber: %s\n",
+                a->node_name, dds_strretcode(a->pub < 0 ? a->pub : a->sub));
         return -1;
     }
+    return 0;
+}
+
+int agent_dds_start(agent_t *a)
+{
+    dds_qos_t *pq = agent_security_qos(a);
+    if (!pq)
+        return -1;
+    a->pp = dds_create_participant((dds_domainid_t)a->o.domain, pq, NULL);
+    dds_delete_qos(pq);
+    if (a->pp < 0) {
+        fprintf(stderr, "ima-dds-node %s: cannot create the DDS participant on domain %u%s: %s\n",
+                a->node_name, a->o.domain, a->o.security_dir ? " with DDS Security" : "",
+                dds_strretcode(a->pp));
+        return -1;
+    }
+    if (create_pub_sub(a) != 0)
+        return -1;
     for (int t = 0; t < T_COUNT; t++) {
-        a->tp[t] = dds_create_topic(a->pp, topic_desc[t], topic_name[t], NULL, NULL);
+        a->tp[t] = dds_create_topic(a->pp, topic_desc[t], agent_topic_name[t], NULL, NULL);
         if (a->tp[t] < 0) {
             fprintf(stderr, "ima-dds-node %s: cannot create topic %s: %s\n", a->node_name,
-                    topic_name[t], dds_strretcode(a->tp[t]));
+                    agent_topic_name[t], dds_strretcode(a->tp[t]));
             return -1;
         }
     }
@@ -158,23 +184,30 @@ int agent_dds_start(agent_t *a)
         if (t == T_HEALTH)
             dds_lset_requested_deadline_missed(l, on_deadline_missed);
         dds_qos_t *q = endpoint_qos(a, t, false);
-        a->rd[t] = dds_create_reader(a->pp, a->tp[t], q, l);
+        a->rd[t] = dds_create_reader(a->sub, a->tp[t], q, l);
         dds_delete_qos(q);
         dds_delete_listener(l);
         if (a->rd[t] < 0) {
             fprintf(stderr, "ima-dds-node %s: cannot create the %s reader: %s\n", a->node_name,
-                    topic_name[t], dds_strretcode(a->rd[t]));
+                    agent_topic_name[t], dds_strretcode(a->rd[t]));
             return -1;
         }
         q = endpoint_qos(a, t, true);
-        a->wr[t] = dds_create_writer(a->pp, a->tp[t], q, NULL);
+        a->wr[t] = dds_create_writer(a->pub, a->tp[t], q, NULL);
         dds_delete_qos(q);
         if (a->wr[t] < 0) {
             fprintf(stderr, "ima-dds-node %s: cannot create the %s writer: %s\n", a->node_name,
-                    topic_name[t], dds_strretcode(a->wr[t]));
+                    agent_topic_name[t], dds_strretcode(a->wr[t]));
             return -1;
         }
     }
+    dds_qos_t *q = dds_create_qos();
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+    a->rd_participants = dds_create_reader(a->pp, DDS_BUILTIN_TOPIC_DCPSPARTICIPANT, q, NULL);
+    dds_delete_qos(q);
+    if (a->rd_participants < 0)
+        agent_log(a, "cannot read the participants' built-in topic: %s; intruders go unlisted",
+                  dds_strretcode(a->rd_participants));
     a->bound_sockets = agent_dds_bind_sockets(a);
     return 0;
 }
@@ -237,65 +270,6 @@ unsigned agent_dds_bind_sockets(agent_t *a)
 
 /* ---- peers ----------------------------------------------------------------------------- */
 
-static agent_writer_t *writer_find(agent_t *a, int topic, dds_instance_handle_t h)
-{
-    for (int i = 0; i < a->n_writers; i++)
-        if (a->writers[i].handle == h && a->writers[i].topic == topic)
-            return &a->writers[i];
-    return NULL;
-}
-
-static agent_writer_t *writer_add(agent_t *a, int topic, dds_instance_handle_t h, unsigned node)
-{
-    agent_writer_t *w = writer_find(a, topic, h);
-    if (w) {
-        if (node)
-            w->node = node;
-        return w;
-    }
-    if (a->n_writers == AGENT_MAX_WRITERS) {
-        /* forget an unmatched one */
-        for (int i = 0; i < a->n_writers; i++)
-            if (!a->writers[i].matched) {
-                a->writers[i] = a->writers[--a->n_writers];
-                break;
-            }
-        if (a->n_writers == AGENT_MAX_WRITERS)
-            return NULL;
-    }
-    w = &a->writers[a->n_writers++];
-    *w = (agent_writer_t){.handle = h, .topic = topic, .node = node};
-    return w;
-}
-
-/* The node a remote writer belongs to, from its USER_DATA; 0 if unknown. */
-static unsigned writer_node(agent_t *a, int topic, dds_instance_handle_t h)
-{
-    agent_writer_t *w = writer_find(a, topic, h);
-    if (w && w->node)
-        return w->node;
-    unsigned node = 0;
-    dds_builtintopic_endpoint_t *ep = dds_get_matched_publication_data(a->rd[topic], h);
-    if (ep) {
-        void *ud = NULL;
-        size_t sz = 0;
-        if (ep->qos && dds_qget_userdata(ep->qos, &ud, &sz) && ud && sz > 0 && sz < 32) {
-            char buf[32];
-            memcpy(buf, ud, sz);
-            buf[sz] = 0;
-            unsigned k;
-            char extra;
-            if (sscanf(buf, UDATA_FMT "%c", &k, &extra) == 1 && k >= 1 && k <= a->o.nodes)
-                node = k;
-        }
-        dds_free(ud);
-        dds_builtintopic_free_endpoint(ep);
-    }
-    if (node)
-        writer_add(a, topic, h, node);
-    return node;
-}
-
 static void peer_lost(agent_t *a, unsigned k, const char *reason)
 {
     if (k < 1 || k > a->o.nodes || k == a->o.node)
@@ -353,13 +327,17 @@ static void peer_alive(agent_t *a, unsigned k)
     }
 }
 
+/* A node's writers come and go one by one: another participant writing in the node's
+ * partition (a second holder of its identity) leaving must not make the node lost while its
+ * agent's writer stays. */
 static void handle_matched(agent_t *a, const agent_ev_t *ev)
 {
     if (ev->change > 0) {
-        unsigned k = writer_node(a, ev->topic, ev->handle);
-        agent_writer_t *w = writer_add(a, ev->topic, ev->handle, k);
-        if (w)
-            w->matched = true;
+        agent_writer_t *w = agent_writer_of(a, ev->topic, ev->handle);
+        if (!w)
+            return;
+        w->matched = true;
+        unsigned k = w->node;
         if (k && k != a->o.node) {
             a->peer[k - 1].matched[ev->topic] = true;
             if (ev->topic == T_INPUTS)
@@ -368,12 +346,13 @@ static void handle_matched(agent_t *a, const agent_ev_t *ev)
         return;
     }
     if (ev->change < 0) {
-        agent_writer_t *w = writer_find(a, ev->topic, ev->handle);
+        agent_writer_t *w = agent_writer_find(a, ev->topic, ev->handle);
         if (!w)
             return;
         w->matched = false;
+        w->alive = false;
         unsigned k = w->node;
-        if (k && k != a->o.node) {
+        if (k && k != a->o.node && !agent_node_has_writer(a, ev->topic, k, false, w)) {
             a->peer[k - 1].matched[ev->topic] = false;
             if (ev->topic == T_INPUTS)
                 peer_lost(a, k, "unmatched");
@@ -383,17 +362,18 @@ static void handle_matched(agent_t *a, const agent_ev_t *ev)
 
 static void handle_liveliness(agent_t *a, const agent_ev_t *ev)
 {
-    unsigned k = writer_node(a, ev->topic, ev->handle);
-    if (!k) {
-        agent_writer_t *w = writer_find(a, ev->topic, ev->handle);
-        k = w ? w->node : 0;
-    }
-    if (!k || k == a->o.node)
+    agent_writer_t *w = agent_writer_of(a, ev->topic, ev->handle);
+    if (!w || !w->node || w->node == a->o.node)
         return;
-    if (ev->change > 0)
+    unsigned k = w->node;
+    if (ev->change > 0) {
+        w->alive = true;
         peer_alive(a, k);
-    else if (ev->change < 0)
-        peer_lost(a, k, ev->not_alive_change > 0 ? "liveliness" : "writer_gone");
+    } else if (ev->change < 0) {
+        w->alive = false;
+        if (!agent_node_has_writer(a, ev->topic, k, true, w))
+            peer_lost(a, k, ev->not_alive_change > 0 ? "liveliness" : "writer_gone");
+    }
 }
 
 static void handle_deadline(agent_t *a, const agent_ev_t *ev)
@@ -542,6 +522,10 @@ static void take_topic(agent_t *a, int t)
                     k = key.node;
                 if (k < 1 || k > a->o.nodes || k == a->o.node)
                     continue;
+                /* a disposal comes from one writer: it must be the node's own */
+                if (si[i].instance_state == DDS_IST_NOT_ALIVE_DISPOSED &&
+                    !agent_from_node(a, t, si[i].publication_handle, k))
+                    continue;
                 if (si[i].instance_state == DDS_IST_NOT_ALIVE_NO_WRITERS) {
                     peer_lost(a, k, "no_writers");
                 } else if (si[i].instance_state == DDS_IST_NOT_ALIVE_DISPOSED) {
@@ -553,13 +537,14 @@ static void take_topic(agent_t *a, int t)
                 }
                 continue;
             }
-            if (k < 1 || k > a->o.nodes || k == a->o.node) {
-                a->ts[t].invalid++; /* not a node of this system: ignored */
+            if (!agent_from_node(a, t, si[i].publication_handle, k))
+                continue;
+            if (k == a->o.node) {
+                a->ts[t].invalid++; /* this node's key from another writer of its partition */
                 continue;
             }
             a->ts[t].read++;
             a->peer[k - 1].last_rx_ns = agent_mono_ns();
-            writer_add(a, t, si[i].publication_handle, k);
             if (t == T_INPUTS) {
                 /* Cyclone stamps the sample in dds_write with the writer's clock, this
                  * machine's as well: the one-way latency of DDS between the two nodes. Not
@@ -642,7 +627,7 @@ int agent_dds_publish(agent_t *a, int topic, const struct xch_hdr *h, const void
     dds_return_t rc = dds_write(a->wr[topic], &s);
     if (rc != DDS_RETCODE_OK) {
         a->ts[topic].write_errors++;
-        agent_log(a, "writing %s failed: %s", topic_name[topic], dds_strretcode(rc));
+        agent_log(a, "writing %s failed: %s", agent_topic_name[topic], dds_strretcode(rc));
         return -1;
     }
     a->ts[topic].written++;

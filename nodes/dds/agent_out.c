@@ -9,9 +9,6 @@
 
 #include "agent__agent.h"
 
-static const char *const topic_names[T_COUNT] = {"rpas_CrossChannelInputs", "rpas_NodeHealth",
-                                                  "rpas_Telemetry", "rpas_MissionData"};
-
 int64_t agent_mono_ns(void)
 {
     struct timespec ts;
@@ -138,6 +135,41 @@ static void write_lat(FILE *f, const char *key, const agent_lat_t *l)
     free(sorted);
 }
 
+static void write_guid(FILE *f, const dds_guid_t *g)
+{
+    for (size_t b = 0; b < sizeof g->v; b++)
+        fprintf(f, "%02x%s", g->v[b], b % 4 == 3 && b < 15 ? ":" : "");
+}
+
+/* The writers whose samples were refused (agent_dds.c from_node): which partition they
+ * write in, the node they claimed, how many, and their participant. */
+static void write_refused(const agent_t *a, FILE *f)
+{
+    fprintf(f, "\"security\":%s,\"refused_samples\":%" PRIu64 ",\"refused\":[",
+            a->o.security_dir ? "true" : "false", a->refused_samples);
+    bool first = true;
+    for (int i = 0; i < a->n_writers; i++) {
+        const agent_writer_t *w = &a->writers[i];
+        if (!w->refused)
+            continue;
+        fprintf(f, "%s{\"topic\":\"%s\",\"partition\":\"%s\",\"claimed_node\":%u,"
+                   "\"samples\":%" PRIu64 ",\"participant\":\"",
+                first ? "" : ",", agent_topic_name[w->topic], w->partition, w->claimed, w->refused);
+        write_guid(f, &w->participant);
+        fputs("\"}", f);
+        first = false;
+    }
+    fputs("],\"foreign_participants\":[", f);
+    for (int i = 0; i < a->n_foreign; i++) {
+        const agent_foreign_t *p = &a->foreign[i];
+        fprintf(f, "%s{\"guid\":\"", i ? "," : "");
+        write_guid(f, &p->guid);
+        fprintf(f, "\",\"process\":\"%s\",\"pid\":%ld,\"refused\":%s}", p->process, p->pid,
+                p->refused ? "true" : "false");
+    }
+    fputs("],", f);
+}
+
 int agent_write_stats(agent_t *a)
 {
     if (!a->o.stats_path)
@@ -156,7 +188,7 @@ int agent_write_stats(agent_t *a)
         fprintf(f,
                 "%s\"%s\":{\"written\":%" PRIu64 ",\"read\":%" PRIu64 ",\"invalid\":%" PRIu64
                 ",\"write_errors\":%" PRIu64 "}",
-                t ? "," : "", topic_names[t], a->ts[t].written, a->ts[t].read, a->ts[t].invalid,
+                t ? "," : "", agent_topic_name[t], a->ts[t].written, a->ts[t].read, a->ts[t].invalid,
                 a->ts[t].write_errors);
     fprintf(f,
             "},\"agreed_frames\":%" PRIu64 ",\"partial\":%" PRIu64 ",\"waits\":%" PRIu64
@@ -175,6 +207,7 @@ int agent_write_stats(agent_t *a)
                 a->faults.f[i].spec.fid, dds_fault_class(&a->faults.f[i]),
                 a->faults.f[i].total_frames);
     fputs("],", f);
+    write_refused(a, f);
     write_lat(f, "exchange_latency_us", &a->xch_lat);
     fputc(',', f);
     write_lat(f, "dds_latency_us", &a->dds_lat);

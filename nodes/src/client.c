@@ -42,7 +42,9 @@ static int read_datagram(canbus_client_t *c, bool block)
     if (n < 0) {
         if (errno == EAGAIN || errno == EWOULDBLOCK)
             return 0;
-        return -errno;
+        if (errno != ECONNRESET)
+            return -errno;
+        n = 0; /* the bus closed with records of ours unread: it is gone all the same */
     }
     if (n == 0) {
         c->stopped = true;
@@ -217,8 +219,15 @@ int canbus_client_done_wait(canbus_client_t *c)
             if ((rc = queue_out(c, &r)) != 0)
                 return rc;
         }
-        if ((rc = canbus_client_flush(c)) != 0)
+        if ((rc = canbus_client_flush(c)) != 0) {
+            /* The bus has closed the connection (it ended the run while this DONE was on
+             * its way): the same as reading its end of file. */
+            if (rc == -EPIPE || rc == -ECONNRESET) {
+                c->stopped = true;
+                return CANBUS_STOPPED;
+            }
             return rc;
+        }
         c->waiting = true;
         c->wait_from_ns = c->ticked ? c->granted_ns : INT64_MIN;
     }

@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* io's input agreement: the sensor samples this node exchanges with the others over DDS, and
  * the agreed inputs it feeds nav_fcs in their place, so that healthy replicas compute from the
- * same data. For each sensor: the newest sample any member holds, its values voted (ima voter:
- * median of 3, average of 2) over the members that hold that same sample. */
+ * same data. For each sensor: the newest sample any member holds (within the bounds of
+ * in_bounds), its values voted (ima voter: median of 3, average of 2) over the members that
+ * hold that same sample. */
 #include <string.h>
 
 #include "io_core.h"
@@ -59,17 +60,38 @@ static bool sample_of(const struct xch_inputs *in, unsigned which, int64_t *t, u
     return true;
 }
 
-/* One sensor's agreed sample: the newest any member holds; its values voted over the members
- * that hold that same sample. Returns the node (0..2) whose copy carries the sample's other
- * fields, or -1 if no member holds one. */
-static int agree(io_red_t *red, const struct xch_agreed *ag, unsigned which, double *out)
+/* Whether a member's sample stamped t may take part in the frame starting at now: not
+ * stamped after the frame's end (no node can have received it yet), not older than the
+ * port's refresh period (stale). A member that sends such stamps is faulty or forged: the
+ * newest sample would otherwise win whatever the others hold. */
+static bool in_bounds(io_red_t *red, unsigned k, unsigned which, int64_t t, int64_t now)
+{
+    if (red->max_age_ns[which] <= 0)
+        return true;
+    if (t <= now + red->frame_ns && now - t <= red->max_age_ns[which])
+        return true;
+    red->refused_stamps[k]++;
+    red->refused_new |= NODE_BIT(k);
+    return false;
+}
+
+/* One sensor's agreed sample: the newest any member holds within the bounds; its values voted
+ * over the members that hold that same sample. Returns the node (0..2) whose copy carries the
+ * sample's other fields, or -1 if no member holds one. */
+static int agree(io_red_t *red, const struct xch_agreed *ag, unsigned which, int64_t now,
+                 double *out)
 {
     int64_t t, newest = -1;
     uint32_t seq, newest_seq = 0;
     const double *values;
     int carrier = -1;
+    uint32_t usable = 0;
     for (unsigned k = 0; k < red->n_nodes; k++)
         if ((ag->present & NODE_BIT(k)) && sample_of(&ag->in[k], which, &t, &seq, &values) &&
+            in_bounds(red, k, which, t, now))
+            usable |= NODE_BIT(k);
+    for (unsigned k = 0; k < red->n_nodes; k++)
+        if ((usable & NODE_BIT(k)) && sample_of(&ag->in[k], which, &t, &seq, &values) &&
             t > newest) {
             newest = t;
             newest_seq = seq;
@@ -80,7 +102,7 @@ static int agree(io_red_t *red, const struct xch_agreed *ag, unsigned which, dou
     double x[VOTER_MAX_CH][VOTER_MAX_DIM] = {{0}};
     uint8_t present = 0;
     for (unsigned k = 0; k < red->n_nodes; k++)
-        if ((ag->present & NODE_BIT(k)) && sample_of(&ag->in[k], which, &t, &seq, &values) &&
+        if ((usable & NODE_BIT(k)) && sample_of(&ag->in[k], which, &t, &seq, &values) &&
             t == newest && seq == newest_seq) {
             memcpy(x[k], values, dims[which] * sizeof(double));
             present |= (uint8_t)NODE_BIT(k);
@@ -91,11 +113,11 @@ static int agree(io_red_t *red, const struct xch_agreed *ag, unsigned which, dou
     return carrier;
 }
 
-void io_apply_agreed(io_red_t *red, io_rx_t *rx, const struct xch_agreed *ag)
+void io_apply_agreed(io_red_t *red, io_rx_t *rx, const struct xch_agreed *ag, int64_t now)
 {
     double v[VOTER_MAX_DIM];
     int k;
-    if ((k = agree(red, ag, IN_GPS, v)) >= 0 && ag->in[k].gps_t_ns > rx->last_gps_t) {
+    if ((k = agree(red, ag, IN_GPS, now, v)) >= 0 && ag->in[k].gps_t_ns > rx->last_gps_t) {
         const struct xch_inputs *c = &ag->in[k];
         rpas_gps_msg_t *g = &rx->gps;
         g->t_ns = c->gps_t_ns;
@@ -105,7 +127,7 @@ void io_apply_agreed(io_red_t *red, io_rx_t *rx, const struct xch_agreed *ag)
         g->lat_deg = v[0], g->lon_deg = v[1], g->alt_ft = v[2], g->gs_kt = v[3], g->trk_deg = v[4];
         rx->gps_new = true;
     }
-    if ((k = agree(red, ag, IN_AHRS, v)) >= 0 && ag->in[k].ahrs_t_ns > rx->last_ahrs_t) {
+    if ((k = agree(red, ag, IN_AHRS, now, v)) >= 0 && ag->in[k].ahrs_t_ns > rx->last_ahrs_t) {
         const struct xch_inputs *c = &ag->in[k];
         rpas_ahrs_msg_t *a = &rx->ahrs;
         a->t_ns = c->ahrs_t_ns;
@@ -116,7 +138,7 @@ void io_apply_agreed(io_red_t *red, io_rx_t *rx, const struct xch_agreed *ag)
         a->ax_g = v[6], a->ay_g = v[7], a->az_g = v[8];
         rx->ahrs_new = true;
     }
-    if ((k = agree(red, ag, IN_AIR, v)) >= 0 && ag->in[k].air_t_ns > rx->last_air_t) {
+    if ((k = agree(red, ag, IN_AIR, now, v)) >= 0 && ag->in[k].air_t_ns > rx->last_air_t) {
         const struct xch_inputs *c = &ag->in[k];
         rpas_air_msg_t *a = &rx->air;
         a->t_ns = c->air_t_ns;

@@ -143,6 +143,11 @@ typedef struct {
     bool selfmon_on, own_voted_out;
     uint32_t peers_voted_out;
     voter_t in_vote[3]; /* GPS, AHRS, air data over the members' copies */
+    /* A member's sample stamped after the end of the frame, or older than its port's refresh
+     * period, is left out of the agreement (0: no bound). */
+    int64_t frame_ns, max_age_ns[3];
+    uint64_t refused_stamps[XCH_MAX_NODES];
+    uint32_t refused_new; /* nodes with a sample refused since the caller last looked */
     struct xch_mission last_mission;
     uint32_t last_mission_frame;
     bool mission_sent;
@@ -164,8 +169,9 @@ typedef struct {
 void io_self_monitor(io_red_t *red, io_monitor_t *out);
 /* This node's samples for the exchange. */
 void io_inputs(const io_rx_t *rx, struct xch_inputs *in);
-/* Replaces rx's samples by the agreed ones (newer than what the ports hold). */
-void io_apply_agreed(io_red_t *red, io_rx_t *rx, const struct xch_agreed *ag);
+/* Replaces rx's samples by the agreed ones (newer than what the ports hold) of the frame
+ * starting at `now`; see frame_ns and max_age_ns for the samples left out. */
+void io_apply_agreed(io_red_t *red, io_rx_t *rx, const struct xch_agreed *ag, int64_t now);
 /* This node's health for DDS. */
 void io_health(const io_red_t *red, uint32_t fcs_mode, struct xch_health *h);
 /* Mission data for DDS when the pilot's targets change, and once a second: true if due. */

@@ -134,6 +134,20 @@ static void watch_replicas(void)
         rpas_report("cross-channel monitor: two replicas left and they disagree");
 }
 
+/* A node whose samples the agreement refused for their time stamps: said once per node. */
+static void report_refused_stamps(void)
+{
+    static uint32_t told;
+    uint32_t fresh = io.red.refused_new & ~told;
+    io.red.refused_new = 0;
+    for (unsigned k = 0; k < io.red.n_nodes; k++)
+        if (fresh & (1u << k))
+            rpas_report("cross-channel agreement: node%u's samples stamped outside the frame or "
+                        "older than their refresh period: left out",
+                        k + 1);
+    told |= fresh;
+}
+
 /* The cross-channel exchange of this frame's inputs, and this node's health. */
 static void exchange_inputs(int64_t t)
 {
@@ -157,7 +171,8 @@ static void exchange_inputs(int64_t t)
         xch_down();
         return;
     }
-    io_apply_agreed(&io.red, &io.rx, &ag);
+    io_apply_agreed(&io.red, &io.rx, &ag, t);
+    report_refused_stamps();
     struct xch_health h;
     io_health(&io.red, io.last_fcs_mode, &h);
     xch_send(XCH_HEALTH, t, &h, sizeof h);
@@ -264,6 +279,11 @@ int main(int argc, char *argv[])
     io_rx_init(&io.rx);
     if (io_red_init(&io.red, &io.cfg) != 0)
         return fail("voting settings", INVALID_CONFIG);
+    /* The agreement's time bounds: the frame, and the refresh period of each sample's port. */
+    io.red.frame_ns = IO_PARTITION_PERIOD_NS;
+    io.red.max_age_ns[0] = io_port_spec[IO_PORT_GPS_OUT].refresh_ns;
+    io.red.max_age_ns[1] = io_port_spec[IO_PORT_AHRS_OUT].refresh_ns;
+    io.red.max_age_ns[2] = io_port_spec[IO_PORT_AIR_OUT].refresh_ns;
     io.xch_on = io.cfg.n_nodes > 1;
     io_faults_init(&io.faults);
     for (unsigned k = 0; k < io.cfg.n_faults; k++) {

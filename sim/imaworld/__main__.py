@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import signal
 import sys
 
 from ima.errors import ImaError
@@ -155,6 +156,12 @@ def run(args) -> int:
     world = World(None, script, args.run_dir, opts,
                   status_out=status_out if args.status else None)
     world.bus = bus = BusClient(args.bus, args.name, proto.ROLE_CAN | proto.ROLE_LOCKSTEP)
+
+    def interrupt(_signum: int, _frame: object) -> None:
+        world.interrupted = True  # the run loop stops the bus at the end of this quantum
+
+    for s in (signal.SIGTERM, signal.SIGINT):
+        signal.signal(s, interrupt)
     try:
         return world.run()
     finally:

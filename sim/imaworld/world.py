@@ -127,6 +127,7 @@ class World:
         self.received: dict[str, int] = {}
         self.crash: tuple[int, str] | None = None
         self.stop_reason: str | None = None
+        self.interrupted = False  # set by a signal: stop at the end of the quantum
         self.t_end = 0
         self.events_f = open(self.run_dir / "world.jsonl", "w")
         self.truth_f = open(self.run_dir / "truth.jsonl", "w")
@@ -444,6 +445,12 @@ class World:
                 self.advance(t_until)
                 self.t_end = t_until
                 bus.done(t_until)
+                if self.interrupted:
+                    # Ctrl-C (the launcher's SIGTERM): the quantum is flown and recorded, the
+                    # bus ends the run for everyone, every trace complete up to here
+                    self.stop_reason = "interrupted"
+                    bus.stop()
+                    break
         except Crash as c:
             t, reason = self.crash
             self.event("world", "crash", t_ns=t, reason=reason)

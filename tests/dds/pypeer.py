@@ -3,7 +3,7 @@
 
     python pypeer.py --domain D --node K --frames N
 
-Creates the agent's four writers (same QoS, USER_DATA "ima-node=K") and readers, waits until
+Creates the agent's four writers (same QoS, in DDS partition "nodeK") and readers, waits until
 an agent's readers match them, publishes CrossChannelInputs for frames 0..N-1 (inputs_for of
 dds_helpers), then prints every CrossChannelInputs sample it reads from other nodes as a JSON
 line, until it has N of them or 20 s passed.
@@ -34,8 +34,8 @@ def main() -> int:
     dds.use_loopback_config()
     from cyclonedds.core import Policy, Qos
     from cyclonedds.domain import DomainParticipant
-    from cyclonedds.pub import DataWriter
-    from cyclonedds.sub import DataReader
+    from cyclonedds.pub import DataWriter, Publisher
+    from cyclonedds.sub import DataReader, Subscriber
     from cyclonedds.topic import Topic
     from cyclonedds.util import duration
 
@@ -44,18 +44,20 @@ def main() -> int:
     dp = DomainParticipant(args.domain)
     dds.bind_dds_sockets("lo")
     writers, readers = {}, {}
+    # an agent tells a writer's node by its partition: node K writes in "nodeK"
+    pub = Publisher(dp, qos=Qos(Policy.Partition([f"node{args.node}"])))
+    sub = Subscriber(dp, qos=Qos(Policy.Partition(["node*"])))
     for name, cls in TOPICS.items():
         depth = 32 if name == "rpas_CrossChannelInputs" else 4
         pol = [Policy.Reliability.Reliable(duration(milliseconds=100)),
                Policy.History.KeepLast(depth), Policy.Durability.TransientLocal,
                Policy.DurabilityService(0, Policy.History.KeepLast(depth), -1, -1, -1),
-               Policy.Liveliness.Automatic(duration(seconds=1)),
-               Policy.Userdata(f"ima-node={args.node}".encode())]
+               Policy.Liveliness.Automatic(duration(seconds=1))]
         if name == "rpas_NodeHealth":
             pol.append(Policy.Deadline(duration(milliseconds=150)))
         tp = Topic(dp, name, cls)
-        writers[name] = DataWriter(dp, tp, qos=Qos(*pol, Policy.WriterDataLifecycle(False)))
-        readers[name] = DataReader(dp, tp, qos=Qos(pol[0], pol[1], pol[2], pol[4]))
+        writers[name] = DataWriter(pub, tp, qos=Qos(*pol, Policy.WriterDataLifecycle(False)))
+        readers[name] = DataReader(sub, tp, qos=Qos(pol[0], pol[1], pol[2], pol[4]))
     end = time.monotonic() + 20
     wr = writers["rpas_CrossChannelInputs"]
     while not wr.get_matched_subscriptions() and time.monotonic() < end:

@@ -30,10 +30,12 @@ def test_parse_ddsperf_without_pongs():
 
 
 def test_measure_both_sides_alternately():
-    """A short real run: two agents and ima-xch-bench, then ddsperf, twice."""
+    """A short real run: two agents and ima-xch-bench, then ddsperf, without security and with
+    it, twice."""
     told = []
     r = bench.measure(samples=20, repeats=2, progress=told.append, ddsperf_seconds=2)
-    assert [t[:5] for t in told] == ["[1/2]", "[1/2]", "[2/2]", "[2/2]"]
+    assert [t[:5] for t in told] == ["[1/2]"] * 4 + ["[2/2]"] * 4
+    assert ["DDS Security" in t for t in told] == [False, False, True, True] * 2
     assert len(r["repeats"]) == 2
     # node1's agent takes node2's inputs of every round, warm-up included
     assert r["dds_latency_samples"] == 2 * (20 + 50)
@@ -44,6 +46,11 @@ def test_measure_both_sides_alternately():
     assert r["ratio"] == round(r["dds_latency_us_median"] / r["ddsperf_latency_us_median"], 2)
     assert r["xch_ratio"] == round(r["xch_latency_us_median"] / r["ddsperf_latency_us_median"],
                                    2)
+    # the same with DDS Security, ddsperf under the same governance
+    assert r["security"] == "sign"
+    assert r["dds_latency_secure_us_median"] > 0 and r["ddsperf_secure_latency_us_median"] > 0
+    assert r["secure_ratio"] == round(r["dds_latency_secure_us_median"]
+                                      / r["ddsperf_secure_latency_us_median"], 2)
 
 
 def test_measure_refuses_nothing_to_measure():

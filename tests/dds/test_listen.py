@@ -14,7 +14,7 @@ from ima.dds import dds_env, xch
 
 
 def test_listener_prints_node_health_of_the_agents(agents, connect, domain):
-    ags = agents(2)
+    ags = agents(2, security="off")  # the listener has no security plugins
     clients = [connect(a) for a in ags]
     listener = subprocess.Popen(
         [sys.executable, "-m", "ima.dds.listen", "--domain", str(domain), "--topic",
@@ -47,7 +47,7 @@ def test_listener_prints_node_health_of_the_agents(agents, connect, domain):
 
 
 def test_listener_text_output_and_timeout(agents, connect, domain):
-    ags = agents(1)
+    ags = agents(1, security="off")
     c = connect(ags[0])
     c.send(xch.MISSION, 3, 150_000_000, xch.pack_mission(mode=2, alt_ft=3000.0, ias_kt=100.0))
     p = subprocess.run([sys.executable, "-m", "ima.dds.listen", "--domain", str(domain),
@@ -60,7 +60,7 @@ def test_listener_text_output_and_timeout(agents, connect, domain):
 
 def test_listener_reports_instance_state_changes(agents, connect, domain):
     """An io link that drops disposes its node's inputs; an agent that ends leaves no writers."""
-    ags = agents(2)
+    ags = agents(2, security="off")  # the listener has no security plugins
     c1, c2 = connect(ags[0]), connect(ags[1])
     listener = subprocess.Popen(
         [sys.executable, "-m", "ima.dds.listen", "--domain", str(domain), "--topic",

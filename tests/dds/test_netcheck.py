@@ -16,7 +16,7 @@ from ima.dds import dds_env, netcheck
 
 
 def test_agents_and_listener_stay_on_loopback(agents, connect, domain):
-    ags = agents(3)
+    ags = agents(3, security="off")  # the listener has no security plugins
     clients = {a.node: connect(a) for a in ags}
     listener = subprocess.Popen([sys.executable, "-m", "ima.dds.listen", "--domain",
                                  str(domain), "--timeout", "30", "--json"],

@@ -55,7 +55,7 @@ def test_types_mirror_the_idl():
 
 def test_python_and_c_agents_exchange_inputs(agent_bin, run_dir, domain):
     """A Python 'agent' of node 2 and the C agent of node 1: each reads what the other writes."""
-    a = start_agent(1, 2, run_dir, domain)
+    a = start_agent(1, 2, run_dir, domain, security="off")  # pypeer has no security plugins
     peer = subprocess.Popen([sys.executable, str(HERE / "pypeer.py"), "--domain", str(domain),
                              "--node", "2", "--frames", "3"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, env=dds_env())

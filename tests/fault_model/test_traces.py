@@ -99,3 +99,28 @@ def test_the_agents_traces_end_where_the_first_agent_was_stopped(tmp_path):
     dds = RunTraces(tmp_path).dds
     assert [e["kind"] for e in dds["node1"]] == ["dds_ready", "dds_deadline_missed"]
     assert [e["kind"] for e in dds["node2"]] == ["dds_ready"]
+
+
+def test_the_agents_traces_end_where_the_nodes_stopped(tmp_path):
+    """Between the nodes' end (their io links close in the last frame) and the agents' stop,
+    a loaded host may let the agents idle past their liveliness lease: what they see then is
+    the run ending. A node lost before the last frame is kept."""
+    (tmp_path / "launch.json").write_text(json.dumps({"nodes": ["node1", "node2"]}))
+    end = 20_000_000_000 - 50_000_000
+
+    def ev(t_wall, kind, t=end, **kw):
+        return {"t_wall_ns": t_wall, "t_ns": t, "node": "n", "src": "dds", "kind": kind, **kw}
+    _write(tmp_path / "dds1.jsonl", [ev(1, "dds_ready", t=0),
+                                     ev(3, "io_disconnect", t=5_000_000_000, reason="closed"),
+                                     ev(4, "dds_peer_lost", t=5_000_000_000, peer="node2",
+                                        reason="liveliness"),
+                                     ev(50, "io_disconnect", reason="closed"),
+                                     ev(1500, "dds_peer_lost", peer="node2", reason="liveliness"),
+                                     ev(1510, "dds_stop", signal=15)])
+    _write(tmp_path / "dds2.jsonl", [ev(2, "dds_ready", t=0),
+                                     ev(60, "io_disconnect", reason="closed"),
+                                     ev(1501, "dds_peer_lost", peer="node1", reason="liveliness"),
+                                     ev(1520, "dds_stop", signal=15)])
+    dds = RunTraces(tmp_path).dds
+    assert [e["kind"] for e in dds["node1"]] == ["dds_ready", "io_disconnect", "dds_peer_lost"]
+    assert [e["kind"] for e in dds["node2"]] == ["dds_ready"]

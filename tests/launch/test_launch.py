@@ -58,7 +58,9 @@ def _run_pids(marker: str) -> dict[int, str]:
 
 def test_dds_stays_on_loopback_and_a_tool_can_listen(launches, tmp_path):
     """While a triplex runs: every socket and multicast membership of its processes is on
-    loopback; the Python cyclonedds listener receives the nodes' health on the run's domain."""
+    loopback; the Python cyclonedds listener receives the nodes' health on the run's domain.
+    The run has DDS Security off: the cyclonedds wheel carries no security plugins, so it
+    could not join a secure run (tests/dds/test_security.py shows that it cannot)."""
     from ima.dds import netcheck
 
     seen: dict = {}
@@ -77,7 +79,8 @@ def test_dds_stays_on_loopback_and_a_tool_can_listen(launches, tmp_path):
              "rpas_NodeHealth", "--count", "30", "--json"],
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
-    run = launches.launch("loopback", duration_s=300.0, seed=SEED, on_status=on_status)
+    run = launches.launch("loopback", duration_s=300.0, seed=SEED, on_status=on_status,
+                          dds_security="off")
     assert seen, "the run ended before the check"
     agents = [p for p, c in seen["pids"].items() if "ima-dds-node" in c]
     assert len(agents) == 3, seen["pids"]
@@ -134,6 +137,17 @@ def test_ctrl_c_stops_everything(tmp_path):
     assert summary["interrupted"] is True and summary["interrupted_at_s"] == summary["flown_s"]
     assert json.loads((run_dir / "summary.json").read_text())["interrupted"] is True
     assert summary["vote_status"] is not None  # the world recorded the run up to the stop
+    # the world stopped first, at the end of a quantum, and ended the run through the bus:
+    # every trace is complete up to the stop
+    last = {name: json.loads((run_dir / name).read_text().splitlines()[-1])
+            for name in ("world.jsonl", "can.jsonl", "node1.jsonl", "node2.jsonl",
+                         "node3.jsonl")}
+    assert last["world.jsonl"]["kind"] == "stop", last
+    assert last["world.jsonl"]["reason"] == "interrupted", last
+    assert last["can.jsonl"]["kind"] == "bus_stop", last
+    for k in (1, 2, 3):
+        assert last[f"node{k}.jsonl"]["kind"] == "module_stop", last
+        assert last[f"node{k}.jsonl"]["reason"] == "bus_stop", last
 
 
 @pytest.mark.parametrize("args,message", [

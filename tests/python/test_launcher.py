@@ -20,6 +20,7 @@ REQUIRED = [
     "python3-dev",
     "cyclonedds-dev",
     "cyclonedds-tools",
+    "openssl",
 ]
 
 

@@ -126,7 +126,7 @@ static void test_agreement(void)
     ag.in[0] = air_sample(100, 4, 100.0);
     ag.in[1] = air_sample(100, 4, 101.0);
     ag.in[2] = air_sample(100, 4, 130.0);
-    io_apply_agreed(&r, &rx, &ag);
+    io_apply_agreed(&r, &rx, &ag, 1000);
     CHECK(rx.air_new && rx.air.t_ns == 100 && rx.air.seq == 4);
     CHECK_NEAR(rx.air.ias_kt, 101.0, 0); /* the median of the three copies */
     CHECK(!rx.gps_new && !rx.ahrs_new);  /* nobody holds one */
@@ -134,13 +134,13 @@ static void test_agreement(void)
 
     /* a newer sample held by one node wins; the older copies are not voted with it */
     ag.in[2] = air_sample(150, 5, 120.0);
-    io_apply_agreed(&r, &rx, &ag);
+    io_apply_agreed(&r, &rx, &ag, 1000);
     CHECK(rx.air_new && rx.air.t_ns == 150);
     CHECK_NEAR(rx.air.ias_kt, 120.0, 0);
     io_rx_written(&rx);
 
     /* nothing newer than what the port holds: not written again */
-    io_apply_agreed(&r, &rx, &ag);
+    io_apply_agreed(&r, &rx, &ag, 1000);
     CHECK(!rx.air_new);
 
     /* a node not present does not count */
@@ -148,9 +148,48 @@ static void test_agreement(void)
     ag.in[0] = air_sample(200, 6, 90.0);
     ag.in[1] = air_sample(200, 6, 92.0);
     ag.in[2] = air_sample(900, 9, 0.0);
-    io_apply_agreed(&r, &rx, &ag);
+    io_apply_agreed(&r, &rx, &ag, 1000);
     CHECK(rx.air.t_ns == 200);
     CHECK_NEAR(rx.air.ias_kt, 91.0, 1e-12); /* the average of two */
+}
+
+/* Samples stamped after the frame's end or older than their port's refresh period are left
+ * out, whatever they hold: a forged far-future stamp would otherwise always be the newest. */
+static void test_agreement_time_bounds(void)
+{
+    io_settings_t s = settings(1, 7, 2, 3);
+    io_red_t r;
+    io_red_init(&r, &s);
+    r.frame_ns = 50;
+    r.max_age_ns[2] = 200; /* air data */
+    io_rx_t rx;
+    io_rx_init(&rx);
+    struct xch_agreed ag;
+    memset(&ag, 0, sizeof ag);
+    ag.present = 7;
+    ag.in[0] = air_sample(900, 4, 100.0);
+    ag.in[1] = air_sample(900, 4, 100.0);
+    ag.in[2] = air_sample(1000000, 5, 500.0); /* far in the future */
+    io_apply_agreed(&r, &rx, &ag, 1000);
+    CHECK(rx.air_new && rx.air.t_ns == 900);
+    CHECK_NEAR(rx.air.ias_kt, 100.0, 0);
+    CHECK(r.refused_stamps[2] == 1 && r.refused_stamps[0] == 0 && r.refused_new == 4);
+    io_rx_written(&rx);
+
+    /* within the frame (its end included) it counts */
+    r.refused_new = 0;
+    ag.in[2] = air_sample(1050, 6, 104.0);
+    io_apply_agreed(&r, &rx, &ag, 1000);
+    CHECK(rx.air_new && rx.air.t_ns == 1050 && r.refused_new == 0);
+    io_rx_written(&rx);
+
+    /* older than the refresh period: stale, left out even when it is all there is */
+    ag.present = 1;
+    ag.in[0] = air_sample(1100, 7, 99.0);
+    io_apply_agreed(&r, &rx, &ag, 1301);
+    CHECK(!rx.air_new && r.refused_stamps[0] == 1);
+    io_apply_agreed(&r, &rx, &ag, 1300);
+    CHECK(rx.air_new && rx.air.t_ns == 1100);
 }
 
 static void test_inputs(void)
@@ -190,6 +229,7 @@ int main(void)
     RUN(test_membership);
     RUN(test_self_monitor);
     RUN(test_agreement);
+    RUN(test_agreement_time_bounds);
     RUN(test_inputs);
     RUN(test_mission_due);
     return UNIT_RESULT();

@@ -20,6 +20,11 @@ t0 and node A's io receives the AGREED holding them at t1.
 
 ratio = dds / ddsperf: what the product's use of DDS costs over DDS's own tool.
 xch_ratio = xch / ddsperf: that, plus the partition-to-agent hops within the nodes.
+
+Each is measured twice: without security, and with DDS Security as runs have it by default
+(the *_secure_* figures: the agents with their run identities, ddsperf with its own identity
+of the same run, the same governance); secure_ratio = dds_secure / ddsperf_secure, and
+security_cost_ratio = dds_secure / dds, what security costs the product.
 """
 
 from __future__ import annotations
@@ -36,7 +41,9 @@ import tempfile
 from pathlib import Path
 
 from ima import dds, paths
+from ima.dds import security
 from ima.dds.agent import start_agents
+from ima.dds.security import Material
 from ima.errors import ImaError
 
 DEFAULT_SAMPLES = 1000
@@ -44,6 +51,7 @@ DEFAULT_REPEATS = 3  # each side measured three times, alternately
 GAP_US = 1000  # pause between the two nodes' INPUTS, and after each round
 DDSPERF_SECONDS = 4  # the first second is warm-up, left out
 DDSPERF_RATE = "500Hz"  # about our rate: one exchange per 2 ms
+DDSPERF_IDENTITY = "ddsperf"  # its grant: every topic and partition of the benchmark's domain
 
 # ddsperf's per-second line: "... size 12 mean 25.7us min 8.8us 50% 15.3us 90% 36.3us ... cnt 494"
 DDSPERF_LINE = re.compile(r"size \d+ mean ([\d.]+)us min ([\d.]+)us 50% ([\d.]+)us "
@@ -57,10 +65,12 @@ def _xch_bench() -> Path:
     return path
 
 
-def _product_latency(domain: int, samples: int, run_dir: Path) -> tuple[dict, dict]:
+def _product_latency(domain: int, samples: int, run_dir: Path,
+                     material: Material | None = None) -> tuple[dict, dict]:
     """(io-to-io figures of ima-xch-bench, node A's agent's DDS latency statistics)."""
     agents = start_agents(2, run_dir, domain, realtime=True,
-                          extra=["--xch-timeout-us", "100000"])
+                          extra=["--xch-timeout-us", "100000"],
+                          security=material if material is not None else "off")
     try:
         p = subprocess.run([str(_xch_bench()), "--socket-a", str(agents[0].socket),
                             "--socket-b", str(agents[1].socket), "--count", str(samples),
@@ -94,11 +104,14 @@ def parse_ddsperf(text: str) -> dict:
             "count": int(sum(r[6] for r in rows))}
 
 
-def _ddsperf_latency(domain: int, seconds: int = DDSPERF_SECONDS) -> dict:
+def _ddsperf_latency(domain: int, seconds: int = DDSPERF_SECONDS,
+                    material: Material | None = None) -> dict:
     exe = shutil.which("ddsperf")
     if not exe:
         raise ImaError("ddsperf not found (Debian package cyclonedds-tools)")
     env = dds.dds_env()
+    if material is not None:  # the same plugins and governance as the agents, its own identity
+        env["CYCLONEDDS_URI"] += "," + security.cyclone_xml(material, DDSPERF_IDENTITY)
     pong = subprocess.Popen([exe, "-D", str(seconds + 2), "-i", str(domain), "pong"],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
     try:
@@ -116,10 +129,13 @@ def _ddsperf_latency(domain: int, seconds: int = DDSPERF_SECONDS) -> dict:
 
 
 def measure(samples: int = DEFAULT_SAMPLES, repeats: int = DEFAULT_REPEATS,
-            progress=None, ddsperf_seconds: int = DDSPERF_SECONDS) -> dict:
-    """Runs both measurements `repeats` times, alternately; `progress(text)` is told what runs
-    next. Each figure is the median of its per-repeat figures (min: the least; samples: the
-    sum), so that a slow moment of the machine weighs on both sides alike."""
+            progress=None, ddsperf_seconds: int = DDSPERF_SECONDS,
+            secure_mode: str = security.DEFAULT_MODE) -> dict:
+    """Runs both measurements `repeats` times, alternately, without security and then with
+    DDS Security in `secure_mode` (the agents and ddsperf alike: the same governance, each
+    its own identity); `progress(text)` is told what runs next. Each figure is the median of
+    its per-repeat figures (min: the least; samples: the sum), so that a slow moment of the
+    machine weighs on both sides alike."""
     say = progress or (lambda text: None)
     if samples < 1 or repeats < 1 or ddsperf_seconds < 2:
         raise ImaError("the DDS benchmark needs at least one sample, one repeat and two "
@@ -128,15 +144,23 @@ def measure(samples: int = DEFAULT_SAMPLES, repeats: int = DEFAULT_REPEATS,
     runs = []
     try:
         with tempfile.TemporaryDirectory(prefix="ima-bench-dds-") as tmp:
+            material = security.prepare(Path(tmp), 2, domain, secure_mode, extra={
+                DDSPERF_IDENTITY: (["*"], ["*"], ("*",))})
             for i in range(repeats):
                 tag = f"{i + 1}/{repeats}"
-                say(f"[{tag}] cross-channel exchange through two agents: {samples} rounds")
-                run_dir = Path(tmp) / f"repeat{i + 1}"
-                run_dir.mkdir()
-                xch, ours = _product_latency(domain, samples, run_dir)
-                say(f"[{tag}] ddsperf ping/pong at {DDSPERF_RATE}: {ddsperf_seconds} s")
-                ref = _ddsperf_latency(domain, ddsperf_seconds)
-                runs.append({"dds": ours, "xch": xch, "ddsperf": ref})
+                run = {}
+                for sec, mat in (("", None), ("secure_", material)):
+                    what = f"with DDS Security ({secure_mode})" if mat else "without security"
+                    say(f"[{tag}] cross-channel exchange through two agents {what}: "
+                        f"{samples} rounds")
+                    run_dir = Path(tmp) / f"repeat{i + 1}{sec and '-secure'}"
+                    run_dir.mkdir()
+                    xch, ours = _product_latency(domain, samples, run_dir, mat)
+                    say(f"[{tag}] ddsperf ping/pong at {DDSPERF_RATE} {what}: "
+                        f"{ddsperf_seconds} s")
+                    ref = _ddsperf_latency(domain, ddsperf_seconds, mat)
+                    run.update({f"{sec}dds": ours, f"{sec}xch": xch, f"{sec}ddsperf": ref})
+                runs.append(run)
     finally:
         dds.release_domain(domain)
 
@@ -149,8 +173,8 @@ def measure(samples: int = DEFAULT_SAMPLES, repeats: int = DEFAULT_REPEATS,
                 f"{side}_latency_us_min": min(r[side]["min"] for r in runs),
                 f"{side}_latency_samples": sum(r[side]["count"] for r in runs)}
 
-    def ratio(side):
-        ref = med("ddsperf", "median")
+    def ratio(side, ref_side="ddsperf"):
+        ref = med(ref_side, "median")
         return round(med(side, "median") / ref, 2) if ref else None
 
     return {
@@ -167,7 +191,18 @@ def measure(samples: int = DEFAULT_SAMPLES, repeats: int = DEFAULT_REPEATS,
         "ddsperf_measure": f"round trip / 2, ddsperf ping {DDSPERF_RATE} / pong",
         "ratio": ratio("dds"),
         "xch_ratio": ratio("xch"),
-        "repeats": [{f"{side}_us": r[side]["median"] for side in ("dds", "xch", "ddsperf")}
+        "security": secure_mode,
+        "dds_latency_secure_us_median": med("secure_dds", "median"),
+        "dds_latency_secure_us_p95": med("secure_dds", "p95"),
+        "xch_latency_secure_us_median": med("secure_xch", "median"),
+        "ddsperf_secure_latency_us_median": med("secure_ddsperf", "median"),
+        "ddsperf_secure_latency_us_p90": med("secure_ddsperf", "p90"),
+        "secure_ratio": ratio("secure_dds", "secure_ddsperf"),
+        "secure_xch_ratio": ratio("secure_xch", "secure_ddsperf"),
+        "security_cost_ratio": ratio("secure_dds", "dds"),
+        "repeats": [{f"{side}_us": r[side]["median"]
+                     for side in ("dds", "xch", "ddsperf", "secure_dds", "secure_xch",
+                                  "secure_ddsperf")}
                     for r in runs],
         "domain": domain,
         "config": str(dds.config_path()),

@@ -10,7 +10,9 @@
   ddsperf_latency_us_median measured in the same run with ddsperf on the same Cyclone
   configuration; xch_latency_us_median: the whole cross-channel path from one node's io
   partition to the other's, which adds the two partition-to-agent hops inside the nodes
-  (ima.bench.dds says how each is measured)."""
+  (ima.bench.dds says how each is measured);
+- dds_latency_secure_us_median and ddsperf_secure_latency_us_median: the same two with DDS
+  Security as runs have it by default (secure_latency_ratio, target ≤ 2 as well)."""
 
 from __future__ import annotations
 
@@ -41,6 +43,10 @@ def run(json_out: bool, duration_s: float = 600.0, seed: int = 1,
     results["ddsperf_latency_us_median"] = lat.get("ddsperf_latency_us_median")
     results["xch_latency_us_median"] = lat.get("xch_latency_us_median")
     ours, ref = results["dds_latency_us_median"], results["ddsperf_latency_us_median"]
+    results["dds_latency_secure_us_median"] = lat.get("dds_latency_secure_us_median")
+    results["ddsperf_secure_latency_us_median"] = lat.get("ddsperf_secure_latency_us_median")
+    results["secure_latency_ratio"] = lat.get("secure_ratio")
+    results["dds_security"] = lat.get("security")
     results["latency_ratio"] = lat.get("ratio")
     results["xch_latency_ratio"] = lat.get("xch_ratio")
     results["dds_bench"] = lat
@@ -48,6 +54,8 @@ def run(json_out: bool, duration_s: float = 600.0, seed: int = 1,
         "speedup": results["speedup"] >= TARGETS["speedup"],
         "dds_latency": results["latency_ratio"] is not None
         and results["latency_ratio"] <= TARGETS["latency_ratio"],
+        "dds_latency_secure": results["secure_latency_ratio"] is not None
+        and results["secure_latency_ratio"] <= TARGETS["latency_ratio"],
         "peak_rss_mb": results["peak_rss_mb"] < TARGETS["peak_rss_mb"],
     }
     if json_out:
@@ -59,6 +67,10 @@ def run(json_out: bool, duration_s: float = 600.0, seed: int = 1,
         out.print(f"node-to-node DDS latency: median {ours} µs; ddsperf on the same config: "
                   f"{ref} µs; ratio {results['latency_ratio']} "
                   f"(target ≤ {TARGETS['latency_ratio']:g}×)")
+        out.print(f"with DDS Security ({results['dds_security']}): median "
+                  f"{results['dds_latency_secure_us_median']} µs; ddsperf with the same "
+                  f"settings: {results['ddsperf_secure_latency_us_median']} µs; ratio "
+                  f"{results['secure_latency_ratio']} (target ≤ {TARGETS['latency_ratio']:g}×)")
         out.print(f"io-to-io cross-channel exchange: median {results['xch_latency_us_median']} µs "
                   f"({results['xch_latency_ratio']}× ddsperf)")
         out.print(f"peak memory of the whole run: {results['peak_rss_mb']:.0f} MB "

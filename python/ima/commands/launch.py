@@ -102,6 +102,12 @@ def add_run_arguments(parser: argparse.ArgumentParser, kind: str = "launch") -> 
                         "axis=AXIS,value=OFFSET")
     parser.add_argument("--test-switch", action="append", default=[], metavar="WHERE:NAME",
                         help=argparse.SUPPRESS)  # test-only: plants violations (docs/campaigns.md)
+    parser.add_argument("--dds-security", choices=("off", "auth", "sign", "encrypt"),
+                        metavar="MODE",
+                        help="DDS Security of the nodes' agents: off, auth (authentication and "
+                        "access control), sign (and a MAC on every message), encrypt (and "
+                        "encrypted messages); default: the system model's channels.dds.security "
+                        "(docs/security.md)")
     parser.add_argument("--netns", action="store_true",
                         help="put each node in its own network namespace joined by a bridge "
                         "(root only), so that a node can really be cut off the network")
@@ -138,7 +144,8 @@ def options_from(args: argparse.Namespace, system: Path | None = None,
         turbulence=args.turbulence, wind_kt=args.wind, realtime=args.realtime,
         run_dir=args.run_dir, kind=kind, kill=list(args.kill_node), hang=list(args.hang_node),
         wrong_output=list(args.test_wrong_output), netns=args.netns, faults=faults_from(args),
-        judge=not args.no_judge, golden=args.golden, test_switches=list(args.test_switch))
+        judge=not args.no_judge, golden=args.golden, test_switches=list(args.test_switch),
+        dds_security=args.dds_security)
 
 
 def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> int:

@@ -96,9 +96,27 @@ class Agent:
         return self.stderr.read_text() if self.stderr and self.stderr.exists() else ""
 
 
+def _security_dir(security, run_dir: Path, nodes: int, domain: int) -> Path | None:
+    """The DDS Security files for the agent: those of a Material, or of `security` mode made
+    in run_dir once (None for "off")."""
+    from ima.dds import security as sec
+
+    if isinstance(security, sec.Material):
+        return security.dir
+    if security == "off":
+        return None
+    if sec.mode_of(run_dir / sec.DIR_NAME) != security:
+        sec.prepare(run_dir, nodes, domain, security)
+    return run_dir / sec.DIR_NAME
+
+
 def start_agent(node: int, nodes: int, run_dir: Path, domain: int, *, realtime: bool = False,
-                extra: list[str] | tuple = (), wait: bool = False) -> Agent:
-    """Starts node's agent with its socket, trace, statistics and stderr in run_dir."""
+                extra: list[str] | tuple = (), wait: bool = False,
+                security="sign") -> Agent:
+    """Starts node's agent with its socket, trace, statistics and stderr in run_dir.
+    `security`: a DDS Security mode (ima.dds.security.MODES; the files are made in run_dir)
+    or the Material of a run; "off" for none (a Python cyclonedds participant can then talk
+    to the agent: it has no security plugins)."""
     run_dir = Path(run_dir)
     sock = run_dir / f"xch{node}.sock"
     trace = run_dir / f"dds{node}.jsonl"
@@ -109,6 +127,9 @@ def start_agent(node: int, nodes: int, run_dir: Path, domain: int, *, realtime: 
             "--trace", str(trace), "--stats", str(stats), "-q"]
     if realtime:
         args.append("--realtime")
+    sec_dir = _security_dir(security, run_dir, nodes, domain)
+    if sec_dir is not None:
+        args += ["--security", str(sec_dir)]
     args += [str(a) for a in extra]
     try:
         pass_fds = (domain_lock_fd(domain),)

@@ -86,7 +86,7 @@ def listen(domain: int, topics: list[str] | None = None, count: int | None = Non
         WaitSet,
     )
     from cyclonedds.domain import DomainParticipant
-    from cyclonedds.sub import DataReader
+    from cyclonedds.sub import DataReader, Subscriber
     from cyclonedds.topic import Topic
     from cyclonedds.util import duration
 
@@ -97,10 +97,12 @@ def listen(domain: int, topics: list[str] | None = None, count: int | None = Non
     dds.bind_dds_sockets("lo")
     qos = Qos(Policy.Reliability.Reliable(duration(milliseconds=100)),
               Policy.Durability.TransientLocal, Policy.History.KeepLast(32))
+    # each node publishes in its own DDS partition, "nodeK" (docs/security.md)
+    sub = Subscriber(dp, qos=Qos(Policy.Partition(["node*"])))
     ws = WaitSet(dp)
     readers = []
     for name in names:
-        rd = DataReader(dp, Topic(dp, name, TOPICS[name]), qos=qos)
+        rd = DataReader(sub, Topic(dp, name, TOPICS[name]), qos=qos)
         cond = ReadCondition(rd, SampleState.Any | ViewState.Any | InstanceState.Any)
         ws.attach(cond)
         readers.append((name, rd))

@@ -571,6 +571,7 @@ class _Builder:
         deadline = self.seconds(at + ("deadline_s",), spec["deadline_s"])
         return {
             "config": config,
+            "security": spec.get("security", "sign"),
             "liveliness_lease_s": lease / NS_PER_S,
             "deadline_s": deadline / NS_PER_S,
             "topics": [t["name"] for t in topics],

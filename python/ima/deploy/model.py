@@ -213,7 +213,9 @@ class System:
     hm_module: dict[int, dict[int, str]]  # Module_HM_Table: state -> error -> action
     channels: list[Channel]
     can: dict  # {"dbc": Path, "bitrate": int}
-    dds: dict  # {"config": Path, "liveliness_lease_s", "deadline_s", "topics": [names]}
+    # {"config": Path, "security": off|auth|sign|encrypt, "liveliness_lease_s", "deadline_s",
+    #  "topics": [names]}
+    dds: dict
     dds_topics: list[dict]  # [{"name", "partition"}]
     voting: dict  # {"thresholds": {axis: float}, "persist": int, "offset_s": float}
     membership: dict  # {"heartbeat": str, "missed_frames": int}

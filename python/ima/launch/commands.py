@@ -40,8 +40,10 @@ def partition_path(first: list[Path]) -> str:
 
 
 def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pilot: Path,
-         modules: dict[str, Path], faults: Plan, domain: int | None) -> RunPlan:
-    """The command lines; `faults` gives the injectors' words (faultinject.plan)."""
+         modules: dict[str, Path], faults: Plan, domain: int | None,
+         security: Path | None = None) -> RunPlan:
+    """The command lines; `faults` gives the injectors' words (faultinject.plan); `security`:
+    the run's DDS Security files (ima.dds.security), None without."""
     names = [n.name for n in system.nodes]
     index = {n.name: n.index for n in system.nodes}
     n = len(names)
@@ -89,6 +91,8 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
                    "--stats", str(run_dir / f"dds{k}.json"), "-q"]
             if opts.realtime:
                 cmd.append("--realtime")
+            if security is not None:
+                cmd += ["--security", str(security)]
             out.agents[f"{node}/dds"] = cmd + faults.dds.get(node, [])
         out.nodes[node] = [
             str(paths.ske_binary()), "--lockstep", str(sock), "--node", node,

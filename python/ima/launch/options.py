@@ -51,6 +51,8 @@ class LaunchOptions:
     # test-only switches that plant a violation an oracle must see: "ske:NAME[=VALUE]" (every
     # node's SKE), "ske@NODE:NAME[=VALUE]" (one node's), "world:NAME[=VALUE]"
     test_switches: list[str] = field(default_factory=list)
+    # DDS Security mode (ima.dds.security.MODES); None: the system model's channels.dds.security
+    dds_security: str | None = None
 
 
 @dataclass

@@ -14,6 +14,7 @@ Files in the run directory:
   can.jsonl      every frame on the bus; canbus.json its statistics; canbus.log
   nodeK.jsonl    node K's SKE trace (schedule, HM, partition reports); nodeK.json; nodeK.log
   ddsK.jsonl     node K's DDS agent trace (wall clock); ddsK.json its statistics; nodeK-dds.log
+  dds-security/  the run's DDS Security certificates and signed documents (ima.dds.security)
   truth.jsonl    the aircraft's true state; world.jsonl, world.json, world.log
   summary.json   written by ima.launch.summary, with flight.png
 """
@@ -45,6 +46,7 @@ from ima.launch.options import (
 )
 
 _READY_TIMEOUT_S = 60.0
+_WORLD_STOP_S = 5.0  # Ctrl-C: how long the world has to stop the bus itself
 
 
 def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None,
@@ -81,8 +83,15 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None,
     sock_dir, sock_tmp = socket_dir(run_dir)
     domain = dds.domain_for_run() if len(names) > 1 else None
     try:
+        security = None
+        if domain is not None:
+            from ima.dds import security as dds_security
+
+            mode = opts.dds_security or system.dds.get("security", dds_security.DEFAULT_MODE)
+            material = dds_security.prepare(run_dir, len(names), domain, mode)
+            security = material.dir if material is not None else None
         return _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp,
-                    domain, on_status, stop_when)
+                    domain, on_status, stop_when, security)
     finally:
         # Every process of the run has ended: its DDS domain is free for the next run (a
         # campaign's worker launches hundreds of runs from one process).
@@ -91,10 +100,10 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None,
 
 
 def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp, domain,
-         on_status, stop_when) -> LaunchRun:
+         on_status, stop_when, security) -> LaunchRun:
     kills, hangs = plan.kills, plan.hangs
     procs_plan = commands.plan(system, opts, run_dir, sock_dir, pilot, deployed.modules, plan,
-                               domain)
+                               domain, security)
     (run_dir / "launch.json").write_text(json.dumps({
         "kind": opts.kind, "system": str(system.path), "nodes": names, "seed": opts.seed,
         "duration_s": opts.duration_s, "pilot": str(pilot), "turbulence": opts.turbulence,
@@ -102,6 +111,7 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
         "host_cpus": len(os.sched_getaffinity(0)), "quantum_us": opts.quantum_us,
         "dds_domain": domain,
         "dds_config": str(system.dds["config"]),
+        "dds_security": str(security) if security is not None else None,
         "faults": [{"id": f.fid, "spec": f.spec(), "class": f.cls, "t_s": f.trigger.at_s}
                    for f in plan.faults],
         "netns": opts.netns, "socket": str(procs_plan.bus_socket), "socket_dir": str(sock_dir),
@@ -120,11 +130,22 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
 
     def on_signal(signum: int, _frame: object) -> None:
         nonlocal interrupted
+        again = interrupted
         interrupted = True
         if watch is not None:
             watch.stopping.set()
-        bus = ps.procs.get("canbus")
-        if bus is not None and bus.poll() is None:
+        bus, world = ps.procs.get("canbus"), ps.procs.get("world")
+        running = bus is not None and bus.poll() is None
+        if running and not again and world is not None and world.poll() is None:
+            # The world first: it ends its quantum, asks the bus to stop and closes its traces,
+            # so that every trace is complete up to the stop. The bus is told itself if the
+            # world has not done it within a few seconds, or at a second Ctrl-C.
+            world.send_signal(signal.SIGTERM)
+            t = threading.Timer(_WORLD_STOP_S, lambda: bus.poll() is None
+                                and bus.send_signal(signal.SIGTERM))
+            t.daemon = True
+            t.start()
+        elif running:
             bus.send_signal(signal.SIGTERM)  # the bus ends the run for everyone
         else:  # still starting: stop what has started
             ps.signal_all(signal.SIGTERM)

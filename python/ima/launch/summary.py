@@ -61,6 +61,35 @@ def _dds_stats(run_dir: Path, node_index: int) -> dict | None:
         return None
 
 
+def dds_refused(dds: dict[str, dict]) -> list[dict]:
+    """The summary's `refused` entries of DDS (what: "dds_participant"): each participant of
+    the run's domain that is not a node's agent, from the agents' statistics, once, with the
+    samples each agent refused from it (keyed as another node than the partition it wrote in,
+    docs/security.md)."""
+    seen: dict[str, dict] = {}
+    for node, st in dds.items():
+        for p in st.get("foreign_participants", []):
+            seen.setdefault(p["guid"], {"process": p.get("process") or "?",
+                                        "pid": p.get("pid"), "refused": {}})
+        for r in st.get("refused", []):
+            entry = seen.setdefault(r["participant"], {"process": "?", "pid": None,
+                                                       "refused": {}})
+            key = (r["topic"], r["partition"], r["claimed_node"])
+            entry["refused"].setdefault(key, {})[node] = r["samples"]
+    out = []
+    for guid, e in sorted(seen.items()):
+        who = e["process"] + (f" (pid {e['pid']})" if e["pid"] else "")
+        detail = f"{who}, participant {guid}, joined the run's DDS domain and is no node's agent"
+        parts = []
+        for (topic, partition, claimed), by in sorted(e["refused"].items()):
+            counts = ", ".join(f"{n} {c}" for n, c in sorted(by.items()))
+            parts.append(f"its {topic} keyed as node{claimed} from partition "
+                         f"'{partition}' were refused ({counts})")
+        detail += ("; " + "; ".join(parts)) if parts else ": none of the agents took its data"
+        out.append({"what": "dds_participant", "detail": detail})
+    return out
+
+
 def summarise(run_dir: Path, pilot: Path, duration_s: float, nodes: list[str],
               killed: dict[str, float], wall_s: float | None = None,
               plot: bool = False, hung: dict[str, float] | None = None) -> dict[str, Any]:
@@ -98,8 +127,18 @@ def summarise(run_dir: Path, pilot: Path, duration_s: float, nodes: list[str],
             dds[node] = st
     if dds:
         summary["dds"] = dds
+        summary["dds_security"] = _security_mode(run_dir) if any(
+            st.get("security") for st in dds.values()) else "off"
+    summary["refused"] = dds_refused(dds)
     write(run_dir, summary)
     return summary
+
+
+def _security_mode(run_dir: Path) -> str:
+    """The DDS Security mode the run's governance document says (ima.dds.security)."""
+    from ima.dds import security
+
+    return security.mode_of(run_dir / security.DIR_NAME) or "on"
 
 
 def write(run_dir: Path, summary: dict) -> None:

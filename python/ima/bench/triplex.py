@@ -30,7 +30,7 @@ def default_system() -> Path:
 
 
 def run(json_out: bool, duration_s: float = 600.0, seed: int = 1,
-        system: Path | None = None) -> int:
+        system: Path | None = None, dds_security: str = "sign") -> int:
     from rich.console import Console
 
     from ima.bench import dds as dds_bench
@@ -38,7 +38,8 @@ def run(json_out: bool, duration_s: float = 600.0, seed: int = 1,
     console = Console(stderr=True)
     results = measure_flight(system or default_system(), duration_s, seed, console)
     with console.status("DDS latency: two agents in real time, then ddsperf") as status:
-        lat = dds_bench.measure(progress=lambda text: status.update(f"DDS latency {text}"))
+        lat = dds_bench.measure(progress=lambda text: status.update(f"DDS latency {text}"),
+                                secure_mode=dds_security)
     results["dds_latency_us_median"] = lat.get("dds_latency_us_median")
     results["ddsperf_latency_us_median"] = lat.get("ddsperf_latency_us_median")
     results["xch_latency_us_median"] = lat.get("xch_latency_us_median")

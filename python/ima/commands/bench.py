@@ -39,6 +39,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     tri.add_argument("--json", action="store_true", help="print the results as JSON")
     tri.add_argument("--duration", type=positive_int, default=600, metavar="SECONDS",
                      help="emulated flight time (default 600)")
+    tri.add_argument("--dds-security", choices=("auth", "sign", "encrypt"), default="sign",
+                     metavar="MODE", help="the DDS Security mode the secure latency is measured "
+                     "in: auth, sign (the default, as runs have it) or encrypt")
     camp = targets.add_parser(
         "campaign", help="the campaign runner: runs per hour of 60 s and 300 s triplex "
         "flights at -j 1 and -j 2, parallel efficiency, runner overhead, peak memory")
@@ -78,7 +81,8 @@ def run(args: argparse.Namespace) -> int:
     if args.target == "triplex":
         from ima.bench import triplex
 
-        return triplex.run(json_out=args.json, duration_s=float(args.duration)) or 0
+        return triplex.run(json_out=args.json, duration_s=float(args.duration),
+                           dds_security=args.dds_security) or 0
     if args.target == "campaign":
         from ima.bench import campaign
 

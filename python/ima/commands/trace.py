@@ -10,6 +10,10 @@ SUBCOMMANDS = {
     "stats": ("bus load per window (exact stuffed frame lengths) and, per identifier, periods "
               "against the DBC's cycle times, gaps, deadline misses; error frames, bus-off",
               "ima.trace.stats"),
+    "replicas": ("the redundancy channels' commands against each other and the voted value, "
+                 "and when a channel was voted out", "ima.trace.replicas"),
+    "diff": ("the first frame at which two runs' CAN traffic diverge, and its signals",
+             "ima.trace.diff"),
 }
 
 

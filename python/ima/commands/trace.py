@@ -14,6 +14,8 @@ SUBCOMMANDS = {
                  "and when a channel was voted out", "ima.trace.replicas"),
     "diff": ("the first frame at which two runs' CAN traffic diverge, and its signals",
              "ima.trace.diff"),
+    "export": ("the frames as an ASC, BLF, candump, TRC or CSV log (python-can's writers)",
+               "ima.trace.export"),
 }
 
 

@@ -46,7 +46,7 @@ def test_export_then_import_gives_the_same_frames(tmp_path, fmt):
     back = source.load(path).frames
     assert len(back) == len(kept), (fmt, len(back), len(kept))
     t0 = kept[0].t_ns
-    for a, b in zip(kept, back):
+    for a, b in zip(kept, back, strict=True):
         assert (b.remote, b.error) == (a.remote, a.error), (fmt, a, b)
         if not a.error:  # an error frame has no identifier
             assert (b.id, b.extended) == (a.id, a.extended), (fmt, a, b)

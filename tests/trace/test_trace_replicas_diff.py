@@ -95,3 +95,26 @@ def test_diff_names_the_first_divergent_frame_and_signal(tmp_path):
     assert p.returncode == 0, p.stderr
     fd = json.loads(p.stdout)["first_divergence"]
     assert fd["t_s"] == 0.6012 and fd["id"] == codec.MESSAGES["ACT_CMD_B"].frame_id
+
+
+def test_plot_draws_signals_and_marks_the_runs_events(tmp_path):
+    d = _replicas_run(tmp_path, bad_from=10, silent_from=None)
+    (d / "world.jsonl").write_text(json.dumps({"t_ns": 600_000_000, "node": "node2",
+                                               "kind": "voted_out", "channel": "B"}) + "\n")
+    (d / "node2.jsonl").write_text(json.dumps({"t_ns": 650_000_000, "node": "node2", "kind": "hm",
+                                               "partition": "io", "error": "APPLICATION_ERROR",
+                                               "action": "IGNORE"}) + "\n")
+    (d / "launch.json").write_text(json.dumps({"faults": [{"id": "f1", "class": "wrong_output",
+                                                           "t_s": 0.5}]}))
+    png = tmp_path / "p.png"
+    p = subprocess.run([sys.executable, "-m", "ima", "trace", "plot", str(d), "--signal",
+                        "ACT_CMD_B.ELEV_CMD_B", "--signal", "ACT_CMD_A.THR_CMD_A", "-o", str(png)],
+                       capture_output=True, text=True, cwd=ROOT)
+    assert p.returncode == 0, p.stderr
+    assert "ACT_CMD_B.ELEV_CMD_B (40 samples)" in p.stdout and "3 events marked" in p.stdout
+    assert png.stat().st_size > 5000
+    bad = subprocess.run([sys.executable, "-m", "ima", "trace", "plot", str(d), "--signal",
+                          "ACT_CMD_B.NOPE", "-o", str(png)], capture_output=True, text=True,
+                         cwd=ROOT)
+    assert bad.returncode != 0 and "has no signal NOPE" in bad.stderr
+    assert "Traceback" not in bad.stderr

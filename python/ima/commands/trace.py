@@ -16,6 +16,8 @@ SUBCOMMANDS = {
              "ima.trace.diff"),
     "export": ("the frames as an ASC, BLF, candump, TRC or CSV log (python-can's writers)",
                "ima.trace.export"),
+    "plot": ("signals over time; a run's faults, vote-outs and HM decisions marked",
+             "ima.trace.plot"),
 }
 
 

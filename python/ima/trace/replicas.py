@@ -98,7 +98,7 @@ def compute(frames, decoder, message: str = "ACT_CMD", thresholds=None, persist=
     per_ch = {ch: {"frames": 0, "max": [0.0] * len(axes), "over": 0} for ch in present_chs}
     inferred, out_set, streak, absent = [], set(), defaultdict(int), defaultdict(int)
     # the vote-outs the actuators decided, in time order: they leave the vote from then on
-    decided = sorted(((round(v["t_s"] * 1e9), v["channel"]) for v in world_voted_out or []))
+    decided = sorted((round(v["t_s"] * 1e9), v["channel"]) for v in world_voted_out or [])
     for k in sorted(periods):
         p = periods[k]
         if world_voted_out is not None:
@@ -125,7 +125,7 @@ def compute(frames, decoder, message: str = "ACT_CMD", thresholds=None, persist=
             d = [abs(p[ch][i] - voted[i]) for i in range(len(axes))]
             st = per_ch[ch]
             st["frames"] += 1
-            st["max"] = [max(x, y) for x, y in zip(st["max"], d)]
+            st["max"] = [max(x, y) for x, y in zip(st["max"], d, strict=True)]
             over = any(d[i] > th[i] for i in range(len(axes)))
             st["over"] += over
             for i, a in enumerate(axes):

@@ -110,7 +110,7 @@ def compute(trace: Trace, dbc=None, window_s: float = DEFAULT_WINDOW_S,
 
 
 def _id_stats(can_id: int, ext: bool, times: list[int], msg) -> dict:
-    periods = sorted((b - a) / 1e6 for a, b in zip(times, times[1:]))
+    periods = sorted((b - a) / 1e6 for a, b in zip(times, times[1:], strict=False))
     cycle = msg.cycle_time if msg is not None and msg.cycle_time else None
     nominal = cycle or _pct(periods, 50)
     late = gaps = 0
@@ -175,10 +175,10 @@ def run(args) -> int:
 
 
 def render(r: dict) -> None:
+    import sys
+
     from rich.console import Console
     from rich.table import Table
-
-    import sys
 
     out = Console(width=None if sys.stdout.isatty() else 120)
     assumed = "" if r["bitrate_known"] else " (assumed: pass --bitrate)"

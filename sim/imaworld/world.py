@@ -23,6 +23,8 @@ from .pilot import LAT_MODE_CODES, MODE_CODES, VERT_MODE_CODES, PilotScript
 from .pilot_model import PilotModel
 from .sensors import Ahrs, AirData, Gps, cas_from_impact, static_pressure
 
+FLUSH_EVERY_NS = NS // 2  # emulated time between two flushes of the world's traces
+
 INF = 1 << 62
 
 _PILOT_MODE = MESSAGES["PILOT_MODE"]
@@ -423,6 +425,7 @@ class World:
         bus = self.bus
         tasks = self._tasks
         next_due = min(tk[0] for tk in tasks)
+        next_flush = FLUSH_EVERY_NS
         wall0 = time.perf_counter()
         try:
             while True:
@@ -445,6 +448,11 @@ class World:
                 self.advance(t_until)
                 self.t_end = t_until
                 bus.done(t_until)
+                if t_until >= next_flush:
+                    # a run killed outright (kill -9) loses at most this much of the traces
+                    self.events_f.flush()
+                    self.truth_f.flush()
+                    next_flush = t_until + FLUSH_EVERY_NS
                 if self.interrupted:
                     # Ctrl-C (the launcher's SIGTERM): the quantum is flown and recorded, the
                     # bus ends the run for everyone, every trace complete up to here

@@ -148,6 +148,14 @@ def test_ctrl_c_stops_everything(tmp_path):
     for k in (1, 2, 3):
         assert last[f"node{k}.jsonl"]["kind"] == "module_stop", last
         assert last[f"node{k}.jsonl"]["reason"] == "bus_stop", last
+    # and the recording holds the run up to the stop
+    from mcap.reader import make_reader
+
+    assert summary["recording"] == str(run_dir / "run.mcap")
+    truth_end = json.loads((run_dir / "truth.jsonl").read_text().splitlines()[-1])["t_ns"]
+    with open(run_dir / "run.mcap", "rb") as f:
+        times = [m.log_time for _, _, m in make_reader(f).iter_messages(topics=["/world/truth"])]
+    assert max(times) == truth_end
 
 
 @pytest.mark.parametrize("args,message", [

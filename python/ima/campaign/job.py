@@ -135,9 +135,21 @@ def run_one(campaign: dict, run: dict, run_dir: Path | None = None) -> dict:
     keep = campaign.get("keep_all") or measures["oracle_violations"] or \
         measures["outcome"] == "undetected_hazardous"
     record["run_dir"] = str(run_dir) if keep else None
-    if not keep:
+    if keep:
+        record["recording"] = _record(run_dir)
+    else:
         shutil.rmtree(run_dir, ignore_errors=True)
     return record
+
+
+def _record(run_dir: Path) -> str | None:
+    """run.mcap of a run the campaign keeps (docs/recording.md); None if it failed."""
+    from ima.recording import write
+
+    try:
+        return write.record(run_dir)["file"]
+    except ImaError:
+        return None
 
 
 def _unflown(campaign: dict, run: dict, run_dir: Path, faults: list, exc: Exception,

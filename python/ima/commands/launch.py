@@ -18,6 +18,7 @@ from ima.launch import options as launch_options
 from ima.launch import report as launch_report
 from ima.launch import run as launch_run
 from ima.launch import summary as launch_summary
+from ima.recording import recorder as recording
 
 
 def positive_float(text: str) -> float:
@@ -183,6 +184,7 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> 
             live.update(Group(state.render(), progress))
 
         result = launch_run.launch(opts, on_status=on_status)
+    recorder = recording.start(result.run_dir)  # on the other CPU while we summarise
     summary = launch_summary.summarise(result.run_dir, pilot, opts.duration_s, result.nodes,
                                        result.killed, result.wall_s, plot=True,
                                        hung=result.hung)
@@ -200,6 +202,8 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> 
             with console.status("judging the run: the golden run, then the oracles"):
                 summary.update(judging_mod.judge(opts, result, system))
         launch_summary.write(result.run_dir, summary)
+    summary.update(recording.finish(recorder))
+    launch_summary.write(result.run_dir, summary)
     failed = {k: v for k, v in result.returncodes.items()
               if v not in (0, None) and k.split("/")[0] not in {**result.killed, **result.hung}}
     if json_out:

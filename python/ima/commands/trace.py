@@ -18,6 +18,7 @@ SUBCOMMANDS = {
                "ima.trace.export"),
     "plot": ("signals over time; a run's faults, vote-outs and HM decisions marked",
              "ima.trace.plot"),
+    "recover": ("RUN_DIR/run.mcap from whatever a run left (a killed run)", "ima.trace.recover"),
 }
 
 

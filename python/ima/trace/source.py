@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The CAN frames of a run directory (the bus's trace, can.jsonl) or of any log python-can
-reads (ASC, BLF, candump .log, TRC, CSV), as one list of Frame, in time order."""
+"""The CAN frames of a run directory (the bus's trace, can.jsonl), of a recording (run.mcap)
+or of any log python-can reads (ASC, BLF, candump .log, TRC, CSV), as one list of Frame, in
+time order."""
 
 from __future__ import annotations
 
@@ -43,11 +44,16 @@ def load(path: Path) -> Trace:
     path = Path(path)
     if path.is_dir():
         trace = path / "can.jsonl"
-        if not trace.is_file():
-            raise ImaError(f"{path}: no can.jsonl (not a run directory of ima fly or ima launch)")
-        return _from_bus_trace(trace, _run_bitrate(path))
+        if trace.is_file():
+            return _from_bus_trace(trace, _run_bitrate(path))
+        if (path / "run.mcap").is_file():
+            return _from_mcap(path / "run.mcap", _run_bitrate(path))
+        raise ImaError(f"{path}: no can.jsonl or run.mcap (not a run directory of ima fly or "
+                       "ima launch)")
     if not path.is_file():
         raise ImaError(f"{path}: no such file or directory")
+    if path.suffix == ".mcap":
+        return _from_mcap(path, _run_bitrate(path.parent))
     if path.name.endswith(".jsonl"):
         return _from_bus_trace(path, _run_bitrate(path.parent))
     if path.suffix.lower() in PYCAN_SUFFIXES:
@@ -98,6 +104,41 @@ def _from_bus_trace(path: Path, bitrate: int | None) -> Trace:
                 ep = off.pop(str(r.get("name")), None)
                 if ep is not None:
                     ep["until_s"] = t / 1e9
+    frames.sort(key=lambda fr: fr.t_ns)
+    return Trace(frames, episodes, str(path), bitrate, end or None)
+
+
+def _from_mcap(path: Path, bitrate: int | None) -> Trace:
+    """The frames of a recording's /can/frames channel, its bus-off episodes from
+    /can/events (docs/recording.md)."""
+    from mcap.exceptions import McapError
+    from mcap.reader import make_reader
+
+    frames: list[Frame] = []
+    off: dict[str, dict] = {}
+    episodes: list[dict] = []
+    end = 0
+    try:
+        with open(path, "rb") as f:
+            for _, ch, m in make_reader(f).iter_messages(topics=["/can/frames", "/can/events"]):
+                r = json.loads(m.data)
+                t = r.get("t_ns", 0)
+                end = max(end, t)
+                if ch.topic == "/can/frames":
+                    error = bool(r.get("error"))
+                    data = b"" if error else bytes.fromhex(r.get("data", ""))
+                    remote = bool(r.get("rtr"))
+                    frames.append(Frame(t, int(r["id"]), bool(r.get("ext")), data, remote,
+                                        error, str(r.get("from", "")),
+                                        int(r.get("len", 0)) if remote else -1))
+                elif r.get("kind") == "bus_off":
+                    ep = off[str(r.get("name"))] = {"t_s": t / 1e9, "client": r.get("name"),
+                                                    "until_s": None}
+                    episodes.append(ep)
+                elif r.get("kind") == "bus_on" and str(r.get("name")) in off:
+                    off.pop(str(r.get("name")))["until_s"] = t / 1e9
+    except (OSError, ValueError, McapError) as e:
+        raise ImaError(f"{path}: not a readable recording: {e}") from e
     frames.sort(key=lambda fr: fr.t_ns)
     return Trace(frames, episodes, str(path), bitrate, end or None)
 

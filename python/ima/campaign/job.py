@@ -15,7 +15,7 @@ from ima.errors import ImaError
 from ima.launch.options import LaunchOptions
 
 # Not in the deterministic part of a record: what the machine, not the run, decides.
-VOLATILE = ("wall_s", "flight_wall_s", "provenance", "refly", "worker", "run_dir")
+VOLATILE = ("wall_s", "flight_wall_s", "provenance", "refly", "worker", "run_dir", "recording")
 
 
 def system_for(campaign_dir: Path, workload: dict, system: str) -> Path:

@@ -139,3 +139,15 @@ def test_a_run_killed_outright_is_recovered(tmp_path, attempt):
     for topic in ("/world/truth", "/node1/schedule", "/node2/schedule", "/node3/schedule"):
         lost = t_kill - _last_t(msgs, topic)
         assert lost <= 1_000_000_000, (topic, lost / 1e9)
+
+
+def test_the_fast_reader_reads_what_the_mcap_package_reads(recorded):
+    from ima.recording import mcapread
+
+    run, _ = recorded
+    topics = ["/can/frames", "/world/truth", "/node2/hm", "/vote"]
+    ours = [(t, time_, data) for t, time_, data in mcapread.messages(run / "run.mcap", topics)]
+    with open(run / "run.mcap", "rb") as f:
+        theirs = [(ch.topic, m.log_time, m.data) for _, ch, m in
+                  make_reader(f).iter_messages(topics=topics, log_time_order=False)]
+    assert sorted(ours) == sorted(theirs) and len(ours) > 1000

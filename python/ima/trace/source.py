@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import struct
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -111,33 +112,34 @@ def _from_bus_trace(path: Path, bitrate: int | None) -> Trace:
 def _from_mcap(path: Path, bitrate: int | None) -> Trace:
     """The frames of a recording's /can/frames channel, its bus-off episodes from
     /can/events (docs/recording.md)."""
+    import orjson
     from mcap.exceptions import McapError
-    from mcap.reader import make_reader
+
+    from ima.recording import mcapread
 
     frames: list[Frame] = []
     off: dict[str, dict] = {}
     episodes: list[dict] = []
     end = 0
     try:
-        with open(path, "rb") as f:
-            for _, ch, m in make_reader(f).iter_messages(topics=["/can/frames", "/can/events"]):
-                r = json.loads(m.data)
-                t = r.get("t_ns", 0)
-                end = max(end, t)
-                if ch.topic == "/can/frames":
-                    error = bool(r.get("error"))
-                    data = b"" if error else bytes.fromhex(r.get("data", ""))
-                    remote = bool(r.get("rtr"))
-                    frames.append(Frame(t, int(r["id"]), bool(r.get("ext")), data, remote,
-                                        error, str(r.get("from", "")),
-                                        int(r.get("len", 0)) if remote else -1))
-                elif r.get("kind") == "bus_off":
-                    ep = off[str(r.get("name"))] = {"t_s": t / 1e9, "client": r.get("name"),
-                                                    "until_s": None}
-                    episodes.append(ep)
-                elif r.get("kind") == "bus_on" and str(r.get("name")) in off:
-                    off.pop(str(r.get("name")))["until_s"] = t / 1e9
-    except (OSError, ValueError, McapError) as e:
+        for topic, _, raw in mcapread.messages(path, ["/can/frames", "/can/events"]):
+            r = orjson.loads(raw)
+            t = r.get("t_ns", 0)
+            end = max(end, t)
+            if topic == "/can/frames":
+                error = bool(r.get("error"))
+                data = b"" if error else bytes.fromhex(r.get("data", ""))
+                remote = bool(r.get("rtr"))
+                frames.append(Frame(t, int(r["id"]), bool(r.get("ext")), data, remote, error,
+                                    str(r.get("from", "")),
+                                    int(r.get("len", 0)) if remote else -1))
+            elif r.get("kind") == "bus_off":
+                ep = off[str(r.get("name"))] = {"t_s": t / 1e9, "client": r.get("name"),
+                                                "until_s": None}
+                episodes.append(ep)
+            elif r.get("kind") == "bus_on" and str(r.get("name")) in off:
+                off.pop(str(r.get("name")))["until_s"] = t / 1e9
+    except (OSError, ValueError, struct.error, McapError) as e:
         raise ImaError(f"{path}: not a readable recording: {e}") from e
     frames.sort(key=lambda fr: fr.t_ns)
     return Trace(frames, episodes, str(path), bitrate, end or None)

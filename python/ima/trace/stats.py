@@ -76,11 +76,12 @@ def compute(trace: Trace, dbc=None, window_s: float = DEFAULT_WINDOW_S,
     worst = [0] * n_win
     count = [0] * n_win
     by_id: dict[tuple[int, bool], list[int]] = defaultdict(list)
-    for f in data:
+    lengths = bits.frame_bits_many([f.id for f in data], [f.extended for f in data],
+                                   [f.remote for f in data], [f.data for f in data])
+    for f, n_bits in zip(data, lengths.tolist(), strict=True):
         w = min(n_win - 1, f.t_ns // win_ns)
-        length = len(f.data) if f.dlc < 0 else f.dlc
-        exact[w] += bits.frame_bits(f.id, f.extended, f.data, f.remote)
-        worst[w] += bits.worst_case_bits(f.extended, 0 if f.remote else length)
+        exact[w] += n_bits
+        worst[w] += bits.worst_case_bits(f.extended, 0 if f.remote else len(f.data))
         count[w] += 1
         by_id[(f.id, f.extended)].append(f.t_ns)
     capacity = rate * window_s

@@ -151,3 +151,16 @@ def test_the_fast_reader_reads_what_the_mcap_package_reads(recorded):
         theirs = [(ch.topic, m.log_time, m.data) for _, ch, m in
                   make_reader(f).iter_messages(topics=topics, log_time_order=False)]
     assert sorted(ours) == sorted(theirs) and len(ours) > 1000
+
+
+def test_no_recording_leaves_the_traces_for_recover(tmp_path):
+    run = tmp_path / "run"
+    p = subprocess.run([IMA, "fly", "--duration", "5", "--run-dir", str(run), "--json",
+                        "--no-recording"], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert "recording" not in json.loads(p.stdout) and not (run / "run.mcap").exists()
+    p = subprocess.run([IMA, "trace", "recover", str(run)], capture_output=True, text=True)
+    assert p.returncode == 0 and "run.mcap" in p.stdout, p.stderr
+    msgs = _messages(run / "run.mcap")
+    assert len(msgs["/world/truth"]) == _lines(run / "truth.jsonl")
+    assert "/node1/schedule" in msgs and "/node1/dds" not in msgs  # one node: no agent

@@ -50,6 +50,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                       help="runs of 60 s flights per measurement (default 8)")
     camp.add_argument("--runs-300", type=positive_int, default=6, metavar="N",
                       help="runs of 300 s flights per measurement (default 6)")
+    tr = targets.add_parser(
+        "trace", help="the recording's cost on a triplex run, ima trace stats on 10-minute and "
+        "1-hour recordings, against python-can's readers")
+    tr.add_argument("--json", action="store_true", help="print the results as JSON")
+    tr.add_argument("--duration", type=positive_int, default=120, metavar="SECONDS",
+                    help="the flights timed with and without recording (default 120)")
+    tr.add_argument("--pairs", type=positive_int, default=3, metavar="N",
+                    help="alternating pairs of flights (default 3)")
     cmp_ = targets.add_parser(
         "compare", help="a benchmark of this checkout against another checkout (the previous "
         "main), alternating, pinned to one CPU; per-pair ratios and their median")
@@ -87,4 +95,8 @@ def run(args: argparse.Namespace) -> int:
         from ima.bench import campaign
 
         return campaign.run(json_out=args.json, runs_60=args.runs_60, runs_300=args.runs_300)
+    if args.target == "trace":
+        from ima.bench import trace
+
+        return trace.run(json_out=args.json, duration=args.duration, pairs=args.pairs)
     raise AssertionError(f"unhandled bench target {args.target}")  # argparse restricts it

@@ -26,4 +26,5 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     opts = launch.options_from(args, system=system_path("rpas_triplex"), kind="demo")
-    return launch.launch_and_summarise(opts, args.json)
+    return launch.launch_and_summarise(opts, args.json,
+                                       not args.no_recording)

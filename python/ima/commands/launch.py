@@ -109,6 +109,9 @@ def add_run_arguments(parser: argparse.ArgumentParser, kind: str = "launch") -> 
                         "access control), sign (and a MAC on every message), encrypt (and "
                         "encrypted messages); default: the system model's channels.dds.security "
                         "(docs/security.md)")
+    parser.add_argument("--no-recording", action="store_true",
+                        help="do not make RUN_DIR/run.mcap at the end (docs/recording.md; "
+                        "`ima trace recover RUN_DIR` makes it later)")
     parser.add_argument("--netns", action="store_true",
                         help="put each node in its own network namespace joined by a bridge "
                         "(root only), so that a node can really be cut off the network")
@@ -149,7 +152,8 @@ def options_from(args: argparse.Namespace, system: Path | None = None,
         dds_security=args.dds_security)
 
 
-def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> int:
+def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
+                         record: bool = True) -> int:
     from rich.console import Console, Group
     from rich.live import Live
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
@@ -184,7 +188,8 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> 
             live.update(Group(state.render(), progress))
 
         result = launch_run.launch(opts, on_status=on_status)
-    recorder = recording.start(result.run_dir)  # on the other CPU while we summarise
+    # the recording is made on the other CPU while we summarise
+    recorder = recording.start(result.run_dir) if record else None
     summary = launch_summary.summarise(result.run_dir, pilot, opts.duration_s, result.nodes,
                                        result.killed, result.wall_s, plot=True,
                                        hung=result.hung)
@@ -202,8 +207,9 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> 
             with console.status("judging the run: the golden run, then the oracles"):
                 summary.update(judging_mod.judge(opts, result, system))
         launch_summary.write(result.run_dir, summary)
-    summary.update(recording.finish(recorder))
-    launch_summary.write(result.run_dir, summary)
+    if record:
+        summary.update(recording.finish(recorder))
+        launch_summary.write(result.run_dir, summary)
     failed = {k: v for k, v in result.returncodes.items()
               if v not in (0, None) and k.split("/")[0] not in {**result.killed, **result.hung}}
     if json_out:
@@ -219,4 +225,4 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool) -> 
 
 
 def run(args: argparse.Namespace) -> int:
-    return launch_and_summarise(options_from(args), args.json)
+    return launch_and_summarise(options_from(args), args.json, not args.no_recording)

@@ -70,8 +70,8 @@ def _summary(f) -> tuple[dict[int, str], list[tuple[int, int, dict[int, int], st
 
 
 def messages(path: Path, topics: list[str]) -> Iterator[tuple[str, int, bytes]]:
-    """(topic, log time, data) of the messages of `topics`, chunk by chunk (time order within
-    a chunk)."""
+    """(topic, log time, data) of the messages of `topics`, chunk by chunk, topic by topic
+    within a chunk, each topic's in the order written."""
     with open(path, "rb") as f:
         head = f.read(len(MAGIC))
         if head != MAGIC:
@@ -97,15 +97,19 @@ def messages(path: Path, topics: list[str]) -> Iterator[tuple[str, int, bytes]]:
             n = _U64.unpack_from(chunk, p)[0]
             data = chunk[p + 8:p + 8 + n]
             records = dctx.decompress(data, max_output_size=raw_size) if comp_name else data
-            off, end = 0, len(records)
-            while off < end:
-                op, ln = _REC.unpack_from(records, off)
-                if op == OP_MESSAGE:
-                    cid, _, t, _ = _MSG.unpack_from(records, off + 9)
-                    topic = want.get(cid)
-                    if topic is not None:
-                        yield topic, t, records[off + 9 + 22:off + 9 + ln]
-                off += 9 + ln
+            # the chunk's message indexes give each wanted message's offset: no walk over the
+            # others (a chunk of the CAN section holds the decoded signals as well)
+            for cid in sorted(want.keys() & idx.keys()):
+                f.seek(idx[cid])
+                head = f.read(9 + 6)
+                op, ln = _REC.unpack_from(head, 0)
+                n = _U32.unpack_from(head, 11)[0]
+                pairs = struct.unpack(f"<{n // 8}Q", f.read(n))
+                topic = want[cid]
+                for k in range(1, len(pairs), 2):
+                    off = pairs[k]
+                    ln = _U64.unpack_from(records, off + 1)[0]
+                    yield topic, pairs[k - 1], records[off + 9 + 22:off + 9 + ln]
 
 
 def _fallback(path: Path, topics: list[str]):

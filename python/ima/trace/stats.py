@@ -5,7 +5,8 @@ against the DBC's cycle times, the gaps and the deadline misses; error frames, b
 - Bus load: the bit times of every frame (bits.frame_bits: exact, stuff bits included) over
   the bit rate times the window; `*_worst_case` uses bits.worst_case_bits instead (what a
   schedulability analysis budgets; the emulated bus times frames with it).
-- Periods: the intervals between consecutive frames of an identifier (p50, p99, max).
+- Periods: the intervals between consecutive frames of an identifier (p50, p99, max; the
+  percentiles are the nearest-rank ones, numpy's "inverted_cdf").
   The nominal period is the DBC's cycle time (GenMsgCycleTime), else the median interval.
   `jitter_ms`: p99 minus p1 of the intervals. A `deadline_miss` is an interval longer than
   the nominal period by more than `late_tolerance` (10 %); a `gap` one of at least 1.5
@@ -14,7 +15,6 @@ against the DBC's cycle times, the gaps and the deadline misses; error frames, b
 
 from __future__ import annotations
 
-from collections import defaultdict
 from pathlib import Path
 
 from ima.trace import bits
@@ -24,14 +24,6 @@ DEFAULT_WINDOW_S = 1.0
 DEFAULT_BITRATE = 1_000_000
 LATE_TOLERANCE = 0.10
 GAP_FACTOR = 1.5
-
-
-def _pct(sorted_values: list[float], q: float) -> float | None:
-    """Nearest-rank percentile of a sorted list."""
-    if not sorted_values:
-        return None
-    k = max(0, min(len(sorted_values) - 1, round(q / 100 * len(sorted_values) + 0.5) - 1))
-    return sorted_values[k]
 
 
 def _r(x: float | None, nd: int = 3) -> float | None:
@@ -68,39 +60,52 @@ def compute(trace: Trace, dbc=None, window_s: float = DEFAULT_WINDOW_S,
     """The statistics of a trace (see the module's doc for each figure)."""
     rate = bitrate or trace.bitrate or DEFAULT_BITRATE
     win_ns = max(1, round(window_s * 1e9))
+    import numpy as np
+
     data = [f for f in trace.frames if not f.error]
-    errors = [f for f in trace.frames if f.error]
+    n_errors = len(trace.frames) - len(data)
     end_ns = max(trace.duration_ns or 0, data[-1].t_ns if data else 0)
     n_win = max(1, -(-end_ns // win_ns))
-    exact = [0] * n_win
-    worst = [0] * n_win
-    count = [0] * n_win
-    by_id: dict[tuple[int, bool], list[int]] = defaultdict(list)
-    lengths = bits.frame_bits_many([f.id for f in data], [f.extended for f in data],
-                                   [f.remote for f in data], [f.data for f in data])
-    for f, n_bits in zip(data, lengths.tolist(), strict=True):
-        w = min(n_win - 1, f.t_ns // win_ns)
-        exact[w] += n_bits
-        worst[w] += bits.worst_case_bits(f.extended, 0 if f.remote else len(f.data))
-        count[w] += 1
-        by_id[(f.id, f.extended)].append(f.t_ns)
+    n = len(data)
+    t = np.fromiter((f.t_ns for f in data), dtype=np.int64, count=n)
+    ids_ = np.fromiter((f.id for f in data), dtype=np.int64, count=n)
+    ext = np.fromiter((f.extended for f in data), dtype=bool, count=n)
+    rtr = np.fromiter((f.remote for f in data), dtype=bool, count=n)
+    exact_bits = bits.frame_bits_many(ids_, ext, rtr, [f.data for f in data])
+    dlen = np.fromiter((0 if f.remote else len(f.data) for f in data), dtype=np.int64, count=n)
+    g = np.where(ext, 54, 34)
+    worst_bits = g + 8 * dlen + 13 + (g + 8 * dlen - 1) // 4  # bits.worst_case_bits
+    w = np.minimum(t // win_ns, n_win - 1)
+    exact = np.bincount(w, weights=exact_bits, minlength=n_win)
+    worst = np.bincount(w, weights=worst_bits, minlength=n_win)
+    count = np.bincount(w, minlength=n_win)
     capacity = rate * window_s
-    windows = [{"t_s": _r(i * window_s), "frames": count[i],
+    windows = [{"t_s": _r(i * window_s), "frames": int(count[i]),
                 "load": _r(exact[i] / capacity, 4), "load_worst_case": _r(worst[i] / capacity, 4)}
                for i in range(n_win)]
     total_s = n_win * window_s
-    ids = [_id_stats(can_id, ext, times, _message(dbc, can_id, ext))
-           for (can_id, ext), times in sorted(by_id.items())]
+    # per identifier: its frames' times, in order (a stable sort keeps equal times' order)
+    key = ids_ * 2 + ext
+    order = np.argsort(key, kind="stable")
+    keys_sorted = key[order]
+    starts = np.flatnonzero(np.r_[True, keys_sorted[1:] != keys_sorted[:-1]])
+    bounds = np.r_[starts, n]
+    ids = []
+    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+        k = int(keys_sorted[a])
+        can_id, is_ext = k >> 1, bool(k & 1)
+        ids.append(_id_stats(can_id, is_ext, np.sort(t[order[a:b]]),
+                             _message(dbc, can_id, is_ext)))
     return {
         "source": trace.source,
         "frames": len(data),
-        "error_frames": len(errors),
+        "error_frames": n_errors,
         "duration_s": _r(end_ns / 1e9),
         "bitrate": rate,
         "bitrate_known": bool(bitrate or trace.bitrate),
         "window_s": window_s,
-        "bus_load": _r(sum(exact) / (rate * total_s), 4),
-        "bus_load_worst_case": _r(sum(worst) / (rate * total_s), 4),
+        "bus_load": _r(float(exact.sum()) / (rate * total_s), 4),
+        "bus_load_worst_case": _r(float(worst.sum()) / (rate * total_s), 4),
         "bus_load_max": max((w["load"] for w in windows), default=0.0),
         "windows": windows,
         "ids": ids,
@@ -110,15 +115,18 @@ def compute(trace: Trace, dbc=None, window_s: float = DEFAULT_WINDOW_S,
     }
 
 
-def _id_stats(can_id: int, ext: bool, times: list[int], msg) -> dict:
-    periods = sorted((b - a) / 1e6 for a, b in zip(times, times[1:], strict=False))
+def _id_stats(can_id: int, ext: bool, times, msg) -> dict:
+    """times: the identifier's frame times (ns, sorted numpy array)."""
+    import numpy as np
+
+    periods = np.diff(times) / 1e6
     cycle = msg.cycle_time if msg is not None and msg.cycle_time else None
-    nominal = cycle or _pct(periods, 50)
+    p = np.percentile(periods, [1, 50, 99], method="inverted_cdf") if len(periods) else None
+    nominal = cycle or (float(p[1]) if p is not None else None)
     late = gaps = 0
-    if nominal:
-        for p in periods:
-            late += p > nominal * (1 + LATE_TOLERANCE)
-            gaps += p >= nominal * GAP_FACTOR
+    if nominal and len(periods):
+        late = int(np.count_nonzero(periods > nominal * (1 + LATE_TOLERANCE)))
+        gaps = int(np.count_nonzero(periods >= nominal * GAP_FACTOR))
     return {
         "id": can_id,
         "hex": f"0x{can_id:08X}" if ext else f"0x{can_id:03X}",
@@ -126,10 +134,10 @@ def _id_stats(can_id: int, ext: bool, times: list[int], msg) -> dict:
         "name": msg.name if msg is not None else None,
         "count": len(times),
         "cycle_ms": cycle,
-        "period_ms_p50": _r(_pct(periods, 50)),
-        "period_ms_p99": _r(_pct(periods, 99)),
-        "period_ms_max": _r(periods[-1] if periods else None),
-        "jitter_ms": _r(_pct(periods, 99) - _pct(periods, 1)) if periods else None,
+        "period_ms_p50": _r(float(p[1])) if p is not None else None,
+        "period_ms_p99": _r(float(p[2])) if p is not None else None,
+        "period_ms_max": _r(float(periods.max())) if len(periods) else None,
+        "jitter_ms": _r(float(p[2] - p[0])) if p is not None else None,
         "deadline_misses": late,
         "gaps": gaps,
     }

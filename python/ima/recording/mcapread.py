@@ -16,7 +16,6 @@ from ima.recording.mcapfile import (
     OP_CHUNK,
     OP_CHUNK_INDEX,
     OP_FOOTER,
-    OP_MESSAGE,
 )
 
 _U16, _U32, _U64 = struct.Struct("<H"), struct.Struct("<I"), struct.Struct("<Q")

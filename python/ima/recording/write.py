@@ -57,25 +57,30 @@ class _Out:
         self.w.message(ch, seq, t_ns if t_ns > 0 else 0, data)
 
 
-def _lines(path: Path, skipped: dict[str, int]):
-    """(number, line bytes, record) of a JSON-lines trace; a cut or garbled line is counted in
-    skipped[path.name] and left out."""
+def _numbered(path: Path):
+    """(number, line without its newline) of a trace; nothing if it cannot be read."""
     try:
         f = open(path, "rb")  # noqa: SIM115 - closed below
     except OSError:
         return
     with f:
         for i, line in enumerate(f):
-            line = line.rstrip(b"\n")
-            try:
-                rec = orjson.loads(line)
-            except orjson.JSONDecodeError:
-                skipped[path.name] = skipped.get(path.name, 0) + 1
-                continue
-            if isinstance(rec, dict):
-                yield i, line, rec
-            else:
-                skipped[path.name] = skipped.get(path.name, 0) + 1
+            yield i, line.rstrip(b"\n")
+
+
+def _lines(path: Path, skipped: dict[str, int]):
+    """(number, line bytes, record) of a JSON-lines trace; a cut or garbled line is counted in
+    skipped[path.name] and left out."""
+    for i, line in _numbered(path):
+        try:
+            rec = orjson.loads(line)
+        except orjson.JSONDecodeError:
+            skipped[path.name] = skipped.get(path.name, 0) + 1
+            continue
+        if isinstance(rec, dict):
+            yield i, line, rec
+        else:
+            skipped[path.name] = skipped.get(path.name, 0) + 1
 
 
 def _arinc825(can_id: int) -> dict:
@@ -129,25 +134,19 @@ def _raw_lines(path: Path, skipped: dict[str, int]):
     """(number, line, t_ns, kind) of a trace whose lines start with {"t_ns":N, (the SKE's, the
     agents'): read without parsing the JSON; a cut line (no closing brace) is counted and
     left out."""
-    try:
-        f = open(path, "rb")  # noqa: SIM115 - closed below
-    except OSError:
-        return
-    with f:
-        for i, line in enumerate(f):
-            line = line.rstrip(b"\n")
-            comma = line.find(b",", 8)
-            if not line.startswith(_T_PREFIX) or not line.endswith(b"}") or comma < 0:
-                skipped[path.name] = skipped.get(path.name, 0) + 1
-                continue
-            try:
-                t = int(line[8:comma])
-            except ValueError:
-                skipped[path.name] = skipped.get(path.name, 0) + 1
-                continue
-            k = line.find(b'"kind":"')
-            kind = line[k + 8:line.find(b'"', k + 8)] if k >= 0 else b""
-            yield i, line, t, kind
+    for i, line in _numbered(path):
+        comma = line.find(b",", 8)
+        if not line.startswith(_T_PREFIX) or not line.endswith(b"}") or comma < 0:
+            skipped[path.name] = skipped.get(path.name, 0) + 1
+            continue
+        try:
+            t = int(line[8:comma])
+        except ValueError:
+            skipped[path.name] = skipped.get(path.name, 0) + 1
+            continue
+        k = line.find(b'"kind":"')
+        kind = line[k + 8:line.find(b'"', k + 8)] if k >= 0 else b""
+        yield i, line, t, kind
 
 
 _SKE_TOPICS = {b"window_start": "schedule", b"window_end": "schedule", b"hm": "hm"}

@@ -75,7 +75,7 @@ _COLORS = {"fault": "tab:red", "vote": "tab:purple", "hm": "tab:orange"}
 def run(args) -> int:
     import matplotlib
 
-    from ima.trace import source
+    from ima.trace import figure, source
     from ima.trace.decode import Decoder
 
     matplotlib.use("Agg")
@@ -102,13 +102,7 @@ def run(args) -> int:
         axs[0][0].legend(fontsize=8, loc="upper right")
     axs[-1][0].set_xlabel("time (s)")
     fig.suptitle(trace.source, fontsize=9)
-    fig.tight_layout()
-    try:
-        fig.savefig(args.output, dpi=110)
-    except OSError as e:
-        raise ImaError(f"{args.output}: cannot write the plot: {e.strerror}") from e
-    finally:
-        plt.close(fig)
+    figure.save(fig, args.output)
     counts = ", ".join(f"{s} ({len(t)} samples)"
                        for s, (t, _) in zip(args.signal, data, strict=True))
     print(f"{args.output}: {counts}" + (f"; {len(events)} events marked" if events else ""))

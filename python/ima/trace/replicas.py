@@ -231,6 +231,8 @@ def render(r: dict) -> None:
 def plot(r: dict, png: Path) -> None:
     import matplotlib
 
+    from ima.trace import figure
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
@@ -250,10 +252,4 @@ def plot(r: dict, png: Path) -> None:
     axs[0][0].legend(title="channel", loc="upper right", fontsize=8)
     axs[-1][0].set_xlabel("time (s)")
     fig.suptitle(f"{r['source']}: {r['message']} disagreement (red: voted out)", fontsize=9)
-    fig.tight_layout()
-    try:
-        fig.savefig(png, dpi=110)
-    except OSError as e:
-        raise ImaError(f"{png}: cannot write the plot: {e.strerror}") from e
-    finally:
-        plt.close(fig)
+    figure.save(fig, png)

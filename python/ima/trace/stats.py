@@ -218,7 +218,7 @@ def plot(r: dict, png: Path) -> None:
     """The bus load per window, exact and worst-case."""
     import matplotlib
 
-    from ima.errors import ImaError
+    from ima.trace import figure
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -234,10 +234,4 @@ def plot(r: dict, png: Path) -> None:
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
     ax.legend()
-    fig.tight_layout()
-    try:
-        fig.savefig(png, dpi=110)
-    except OSError as e:
-        raise ImaError(f"{png}: cannot write the plot: {e.strerror}") from e
-    finally:
-        plt.close(fig)
+    figure.save(fig, png)

@@ -113,16 +113,22 @@ static struct xch_inputs air_sample(int64_t t, uint32_t seq, double ias)
     return in;
 }
 
-static void test_agreement(void)
+/* Node 2 of three, its ports empty, and an agreement with all three present. */
+static void agreement_setup(io_red_t *r, io_rx_t *rx, struct xch_agreed *ag)
 {
     io_settings_t s = settings(1, 7, 2, 3);
+    io_red_init(r, &s);
+    io_rx_init(rx);
+    memset(ag, 0, sizeof *ag);
+    ag->present = 7;
+}
+
+static void test_agreement(void)
+{
     io_red_t r;
-    io_red_init(&r, &s);
     io_rx_t rx;
-    io_rx_init(&rx);
     struct xch_agreed ag;
-    memset(&ag, 0, sizeof ag);
-    ag.present = 7;
+    agreement_setup(&r, &rx, &ag);
     ag.in[0] = air_sample(100, 4, 100.0);
     ag.in[1] = air_sample(100, 4, 101.0);
     ag.in[2] = air_sample(100, 4, 130.0);
@@ -157,16 +163,12 @@ static void test_agreement(void)
  * out, whatever they hold: a forged far-future stamp would otherwise always be the newest. */
 static void test_agreement_time_bounds(void)
 {
-    io_settings_t s = settings(1, 7, 2, 3);
     io_red_t r;
-    io_red_init(&r, &s);
+    io_rx_t rx;
+    struct xch_agreed ag;
+    agreement_setup(&r, &rx, &ag);
     r.frame_ns = 50;
     r.max_age_ns[2] = 200; /* air data */
-    io_rx_t rx;
-    io_rx_init(&rx);
-    struct xch_agreed ag;
-    memset(&ag, 0, sizeof ag);
-    ag.present = 7;
     ag.in[0] = air_sample(900, 4, 100.0);
     ag.in[1] = air_sample(900, 4, 100.0);
     ag.in[2] = air_sample(1000000, 5, 500.0); /* far in the future */

@@ -16,6 +16,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "ske__coverage.h"
 #include "ske__sandbox.h"
 
 extern char **environ;
@@ -365,6 +366,7 @@ void ske__reap(ske_t *s)
 void ske__kill_partition(ske_part_t *p)
 {
     if (p->pid > 0) {
+        ske__coverage_dump(p->pid); /* coverage builds only: its counters first */
         kill(-p->pid, SIGKILL); /* its process group: anything it may have started, too */
         kill(p->pid, SIGKILL);
         waitpid(p->pid, NULL, 0);

@@ -48,6 +48,8 @@ def gcovr_command(python: str, root: Path, build: Path) -> list[str]:
         cmd += ["--filter", base + folder + "/"]
     for pattern in EXCLUDED:
         cmd += ["--exclude", base + pattern]
+    # The tests' own objects are not searched either (their counters are of no interest).
+    cmd += ["--exclude-directories", re.escape(str(build.resolve())) + r"/(.+/)?tests?(/|$)"]
     return cmd + [str(build)]
 
 

@@ -1,10 +1,13 @@
 # SPDX-License-Identifier: Apache-2.0
 """ima-dds-node's command line: a bad or missing option is named and exits 2 before DDS
-starts; a configuration or trace it cannot use exits 1 saying which."""
+starts; a configuration, trace, socket or statistics file it cannot use exits 1 saying
+which."""
 
 from __future__ import annotations
 
 import os
+import signal
+import socket
 import subprocess
 from pathlib import Path
 
@@ -71,3 +74,52 @@ def test_an_unwritable_trace_stops_the_agent(tmp_path):
     assert p.returncode == 1
     assert "cannot write the trace" in p.stderr
     assert not (tmp_path / "xch.sock").exists()
+
+
+@pytest.mark.parametrize(("where", "says"), [
+    ("file", "exists and is not a socket"),
+    ("missing/xch.sock", "cannot listen at"),
+    ("s" * 120, "socket path longer than"),
+    ("live.sock", "another agent is listening at"),
+])
+def test_a_socket_it_cannot_take_stops_the_agent(tmp_path, where, says):
+    path = tmp_path / where
+    (tmp_path / "file").write_text("")
+    live = socket.socket(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+    live.bind(str(tmp_path / "live.sock"))
+    live.listen(1)
+    try:
+        args = _required(tmp_path)
+        args[args.index("--socket") + 1] = str(path)
+        p = _agent(*args)
+    finally:
+        live.close()
+    assert p.returncode == 1, p.stderr
+    assert says in p.stderr
+    assert p.stdout == ""
+
+
+def test_a_stale_socket_is_taken_over_and_unwritable_statistics_fail_the_run(tmp_path, domain):
+    """The socket of an agent that died is replaced; the run ends on SIGTERM, and statistics
+    that cannot be written make it a failure."""
+    sock = tmp_path / "xch.sock"
+    stale = socket.socket(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+    stale.bind(str(sock))
+    stale.close()
+    env = dict(os.environ, IMA_DDS_CONFIG=str(CONFIG))
+    stats = tmp_path / "missing" / "stats.json"
+    p = subprocess.Popen([str(AGENT), "--node", "1", "--nodes", "1", "--socket", str(sock),
+                          "--domain", str(domain), "--startup-timeout-ms", "0", "-q",
+                          "--stats", str(stats)],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        assert p.stdout.readline() == "ready\n"
+        p.send_signal(signal.SIGTERM)
+        _, err = p.communicate(timeout=30)
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+    assert p.returncode == 1, err
+    assert f"cannot write statistics to {stats}" in err
+    assert not sock.exists()  # removed at the end

@@ -63,7 +63,7 @@ def summary(outcomes: Sequence[Outcome]) -> tuple[str, int]:
 # The unit tests, built a second time with AddressSanitizer and UndefinedBehaviorSanitizer.
 SANITIZED_TARGETS = ("test_config", "test_port_buf", "test_plan", "test_hm", "test_create",
                      "test_sandbox_policy", "test_canbus_wire", "test_canbus_socket",
-                     "test_canbus_client",
+                     "test_canbus_client", "test_canbus_wire_oom",
                      "nav_fcs_test_nf_math", "nav_fcs_test_nav", "nav_fcs_test_fcs",
                      "io_test_settings", "io_test_can_rx", "io_test_can_tx", "io_test_redundancy",
                      "test_fi_spec", "test_voter", "test_canbus_fault", "test_fi_wrong_output",

@@ -50,6 +50,15 @@ static ske_module_cfg_t *load_with_output_file(void)
     return load(path);
 }
 
+/* ske_create of m with its trace at tmp_dir/name (the path left in trace). */
+static int create_tracing(const ske_module_cfg_t *m, const char *name, char trace[PATH_MAX],
+                          ske_t **s, char *err, size_t errlen)
+{
+    snprintf(trace, PATH_MAX, "%s/%s", tmp_dir, name);
+    ske_run_opts_t o = {.frames = 1, .time_mode = -1, .trace_path = trace};
+    return ske_create(m, &o, s, err, errlen);
+}
+
 static void test_options_that_cannot_apply(void)
 {
     ske_module_cfg_t *m = load(EXAMPLE);
@@ -78,10 +87,8 @@ static void test_files_it_cannot_write(void)
     ske_module_cfg_t *m = load(EXAMPLE);
     REQUIRE(m != NULL);
     char err[512] = "", trace[PATH_MAX];
-    snprintf(trace, sizeof trace, "%s/missing/trace.jsonl", tmp_dir);
-    ske_run_opts_t o = {.frames = 1, .time_mode = -1, .trace_path = trace};
     ske_t *s = (ske_t *)1;
-    CHECK_EQ(ske_create(m, &o, &s, err, sizeof err), SKE_E_IO);
+    CHECK_EQ(create_tracing(m, "missing/trace.jsonl", trace, &s, err, sizeof err), SKE_E_IO);
     CHECK(s == NULL);
     CHECK_CONTAINS(err, "cannot write the trace");
     CHECK_CONTAINS(err, trace);
@@ -137,10 +144,8 @@ static void test_drain_events(void)
     ske_module_cfg_t *m = load(EXAMPLE);
     REQUIRE(m != NULL);
     char err[512] = "", trace[PATH_MAX];
-    snprintf(trace, sizeof trace, "%s/events.jsonl", tmp_dir);
-    ske_run_opts_t o = {.frames = 1, .time_mode = -1, .trace_path = trace};
     ske_t *s = NULL;
-    CHECK_EQ(ske_create(m, &o, &s, err, sizeof err), SKE_OK);
+    CHECK_EQ(create_tracing(m, "events.jsonl", trace, &s, err, sizeof err), SKE_OK);
     REQUIRE(s != NULL);
     ske_part_t *p = &s->parts[0]; /* producer: ports SP_STATE, QP_CMD */
     ske_ctl_t *c = p->ctl;

@@ -86,3 +86,12 @@ def test_a_program_that_cannot_be_executed_stops_the_module(ske_binary, tmp_path
     assert p.returncode == 1
     assert f"cannot start partition 'monitor': {broken}: No such file or directory" in p.stderr
     assert '"kind":"window_start"' not in trace.read_text()
+
+
+@pytest.mark.parametrize("option", ["--trace", "--stats"])
+def test_a_full_disk_under_the_trace_or_statistics_fails_the_run(ske_binary, option):
+    """Recorded data that could not be written is a failed run, whatever else went right."""
+    p = _ske(ske_binary, "--frames", "2", "-q", option, "/dev/full", str(EXAMPLE))
+    assert p.returncode == 1
+    what = "trace" if option == "--trace" else "statistics"
+    assert f"the {what} /dev/full could not be written: No space left on device" in p.stderr

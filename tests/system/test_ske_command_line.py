@@ -5,6 +5,7 @@ documented status (2 usage, invalid module or fault; 1 run-time failure), runs n
 from __future__ import annotations
 
 import os
+import resource
 import subprocess
 from pathlib import Path
 
@@ -95,3 +96,30 @@ def test_a_full_disk_under_the_trace_or_statistics_fails_the_run(ske_binary, opt
     assert p.returncode == 1
     what = "trace" if option == "--trace" else "statistics"
     assert f"the {what} /dev/full could not be written: No space left on device" in p.stderr
+
+
+def test_too_few_descriptors_stop_the_start_with_one_line(ske_binary):
+    """With the descriptor limit raised one by one from 4: ima-ske runs out while creating its
+    port memory, then the read-only views of destination ports, then the control blocks, then
+    the pipe of a partition's start; each time it stops with status 1 and one line naming what
+    it could not create, before any partition runs."""
+    kinds = {"port memory for": 0, "read-only port descriptor": 0, "control block": 0,
+             "cannot start partition 'producer'": 0}
+    for n in range(4, 40):
+        def limit(n=n):
+            resource.setrlimit(resource.RLIMIT_NOFILE, (n, n))
+
+        env = dict(os.environ, IMA_PARTITION_PATH=str(PARTITIONS))
+        p = subprocess.run([str(ske_binary), "--frames", "1", "-q", str(EXAMPLE)],
+                           capture_output=True, text=True, timeout=60, env=env,
+                           preexec_fn=limit)
+        line = p.stderr.strip()
+        kind = next((k for k in kinds if k in line), None)
+        if kind is None:
+            break  # past the parent's own descriptors
+        assert p.returncode == 1 and "\n" not in line, (n, p)
+        assert line.endswith("Too many open files"), line
+        kinds[kind] += 1
+        if kind.startswith("cannot start"):
+            break
+    assert all(kinds.values()), kinds

@@ -4,6 +4,7 @@ opens; a bus that cannot open its socket, trace or statistics exits 1 saying whi
 
 from __future__ import annotations
 
+import json
 import os
 import socket
 import subprocess
@@ -103,3 +104,17 @@ def test_a_live_socket_is_not_taken_over_a_stale_one_is(tmp_path):
     assert sock.exists()
     p = _bus("--socket", str(sock), "--end-ns", "0", "-q")
     assert p.returncode == 0, p.stderr
+
+
+def test_a_full_disk_under_its_trace_or_statistics_fails_the_bus(tmp_path):
+    base = ["--socket", str(tmp_path / "can.sock"), "--duration", "0.01", "-q"]
+    p = _bus(*base, "--stats", "/dev/full")
+    assert p.returncode == 1 and "cannot write /dev/full: Input/output error" in p.stderr
+    p = _bus(*base, "--trace", "/dev/full")
+    assert p.returncode == 1 and "writing the trace failed" in p.stderr
+    # Both on standard output: the trace's lines, then the statistics.
+    p = _bus(*base, "--trace", "-", "--stats", "-")
+    assert p.returncode == 0, p.stderr
+    lines = [json.loads(line) for line in p.stdout.splitlines()]
+    assert lines[-2]["kind"] == "bus_stop" and lines[-1]["quanta"] == 2, lines
+

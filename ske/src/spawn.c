@@ -16,6 +16,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "ske__coverage.h"
 #include "ske__sandbox.h"
 
 extern char **environ;
@@ -119,8 +120,16 @@ static void fill_ctl(ske_t *s, ske_part_t *p)
 
 static void child_exec(ske_t *s, ske_part_t *p, int errpipe, char **envp) __attribute__((noreturn));
 
+/* The child gives up: ima-ske learns why from the exec-error pipe. */
+static void __attribute__((noreturn)) child_fail(void)
+{
+    ske__coverage_child_flush();
+    _exit(127);
+}
+
 static void child_exec(ske_t *s, ske_part_t *p, int errpipe, char **envp)
 {
+    ske__coverage_child_start();
     int n = p->cfg->n_ports;
     /* Partitions live in their own process group: a terminal's Ctrl-C reaches the SKE
      * only, which then stops them. They die with the SKE. */
@@ -183,20 +192,21 @@ static void child_exec(ske_t *s, ske_part_t *p, int errpipe, char **envp)
     }
     close_range((unsigned)last + 1, ~0U, 0);
     if (getppid() != s->pid)
-        _exit(127); /* the SKE is already gone */
+        child_fail(); /* the SKE is already gone */
     /* Last before the exec: the memory limit and the loader's system-call filter. A failure
      * goes to the SKE as a negative number, told apart from an exec error. */
     int confined = ske__sandbox_enter(p->cfg, 3, n, out_high >= 0 ? 5 + n : -1);
     if (confined != 0) {
         ssize_t wc = write(4 + n, &confined, sizeof confined);
         (void)wc;
-        _exit(127);
+        child_fail();
     }
+    ske__coverage_child_flush();
     execve(p->cfg->executable, p->cfg->argv, envp);
     int e = errno;
     ssize_t w = write(4 + n, &e, sizeof e);
     (void)w;
-    _exit(127);
+    child_fail();
 }
 
 /* The SKE's environment with the partition's descriptors; out holds the output file's
@@ -365,6 +375,7 @@ void ske__reap(ske_t *s)
 void ske__kill_partition(ske_part_t *p)
 {
     if (p->pid > 0) {
+        ske__coverage_dump(p->pid); /* coverage builds only: its counters first */
         kill(-p->pid, SIGKILL); /* its process group: anything it may have started, too */
         kill(p->pid, SIGKILL);
         waitpid(p->pid, NULL, 0);

@@ -687,6 +687,63 @@ static const bad_case_t bad_cases[] = {
      "a port belongs to one channel", {"'S_IN'", "channel 's'"}},
     {"duplicate channel identifier", "ChannelIdentifier=\"2\"", "ChannelIdentifier=\"1\"", NULL, NULL,
      "ChannelName=\"q\"", "Channel", "channel identifiers are unique", {"ChannelIdentifier=1", NULL}},
+    {"sampling port refreshed never",
+     "Name=\"S_OUT\" MaxMessageSize=\"16\" Direction=\"SOURCE\" RefreshRateSeconds=\"0.1\"",
+     "Name=\"S_OUT\" MaxMessageSize=\"16\" Direction=\"SOURCE\" RefreshRateSeconds=\"0\"", NULL, NULL,
+     "Name=\"S_OUT\"", "Sampling_Port", "RefreshRateSeconds is positive",
+     {"RefreshRateSeconds must be greater than 0", NULL}},
+    {"queuing port over 64 MiB",
+     "Name=\"Q_OUT\" MaxMessageSize=\"8\" Direction=\"SOURCE\" MaxNbMessages=\"4\"",
+     "Name=\"Q_OUT\" MaxMessageSize=\"1048576\" Direction=\"SOURCE\" MaxNbMessages=\"65\"",
+     NULL, NULL, "Name=\"Q_OUT\"", "Queuing_Port", "a queuing port holds at most 64 MiB",
+     {"MaxNbMessages=65 of 1048576 bytes needs 65 MiB", NULL}},
+    {"too many arguments", "<ima:Linux Executable=\"p2\"/>",
+     "<ima:Linux Executable=\"p2\" Arguments=\"a b c d e f g h i j k l m n o p q r s t u v w x y z "
+     "A B C D E\"/>", NULL, NULL, "Executable=\"p2\"", "Linux", "at most 30 arguments",
+     {"too many Arguments for partition 'p2'", NULL}},
+    {"partition without a program", "<ima:Linux Executable=\"p2\"/>", "", NULL, NULL,
+     "<Partition PartitionIdentifier=\"2\"", "Partition", "each Partition has an ima:Linux element",
+     {"partition 'p2' does not say which program runs it", NULL}},
+    {"empty module name", "ModuleName=\"unit\"", "ModuleName=\"\"", NULL, NULL,
+     "<ARINC_653_Module", "ARINC_653_Module", "a module name of 1 to 63 characters",
+     {"ModuleName is empty", NULL}},
+    {"HM log port that is not its own", "<ima:Linux Executable=\"p2\"/>",
+     "<ima:Linux Executable=\"p2\" HealthMonitorLogPort=\"HM_LOG\"/>", NULL, NULL,
+     "<Partition PartitionIdentifier=\"2\"", "Partition",
+     "the health-monitor log port is one of the partition's destination queuing ports, on no "
+     "channel, of at least the size of a decision",
+     {"HealthMonitorLogPort 'HM_LOG' is not one of its ports", NULL}},
+    {"HM log port on a channel", "<ima:Linux Executable=\"p2\"/>",
+     "<ima:Linux Executable=\"p2\" HealthMonitorLogPort=\"Q_IN\"/>", NULL, NULL,
+     "<Queuing_Port Name=\"Q_IN\"", "Queuing_Port",
+     "the health-monitor log port is one of the partition's destination queuing ports, on no "
+     "channel, of at least the size of a decision",
+     {"HealthMonitorLogPort 'Q_IN' must be a destination queuing port on no channel", NULL}},
+    {"HM log port that is a sampling port", "<ima:Linux Executable=\"p2\"/>",
+     "<ima:Linux Executable=\"p2\" HealthMonitorLogPort=\"S_IN\"/>", NULL, NULL,
+     "<Sampling_Port Name=\"S_IN\"", "Queuing_Port", NULL,
+     {"HealthMonitorLogPort 'S_IN' must be a destination queuing port", NULL}},
+    {"document type declaration", "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n",
+     "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<!DOCTYPE ARINC_653_Module>\n", NULL, NULL,
+     "<!DOCTYPE", "", "no document type declaration", {"DOCTYPE", NULL}},
+    {"channel source used twice",
+     "<Source><Standard_Partition PartitionIdentifier=\"1\" PartitionName=\"p1\" PortName=\"Q_OUT\"/></Source>",
+     "<Source><Standard_Partition PartitionIdentifier=\"1\" PartitionName=\"p1\" PortName=\"S_OUT\"/></Source>",
+     NULL, NULL, "PortName=\"S_OUT\"/></Source>\n      <Destination><Standard_Partition PartitionIdentifier=\"2\" PartitionName=\"p2\" PortName=\"Q_IN\"",
+     "Source", "a port belongs to one channel", {"'S_OUT'", "already the source of channel 's'"}},
+    {"identifier past its range", "<Partition PartitionIdentifier=\"2\" PartitionName=\"p2\">",
+     "<Partition PartitionIdentifier=\"3000000000\" PartitionName=\"p2\">", NULL, NULL,
+     "PartitionIdentifier=\"3000000000\"", "Partition", "numbers are within their range",
+     {"PartitionIdentifier='3000000000' is too large: at most 2147483647", NULL}},
+    {"malformed stack size", "<ima:Linux Executable=\"p2\"/>",
+     "<Process Name=\"w\" StackSize=\"64k\"/>\n    <ima:Linux Executable=\"p2\"/>", NULL, NULL,
+     "StackSize=\"64k\"", "Process", "numbers are positive integers",
+     {"StackSize='64k' is not a valid number", "(decimal or 0x-hexadecimal)"}},
+    {"malformed memory size", "  <Module_Schedule",
+     "  <Partition_Memory PartitionIdentifier=\"2\" PartitionName=\"p2\"><Memory_Requirements SizeBytes=\"32MB\"/></Partition_Memory>\n"
+     "  <Module_Schedule", NULL, NULL,
+     "SizeBytes=\"32MB\"", "Memory_Requirements", "numbers are positive integers",
+     {"SizeBytes='32MB' is not a valid number", "(decimal or 0x-hexadecimal)"}},
     {"not well-formed", "</Connection_Table>", "</Connection_Tabel>", NULL, NULL,
      "</Connection_Tabel>", "", "well-formed XML", {"Connection_Table", NULL}},
     {"unknown element", "<ima:Linux Executable=\"p2\"/>", "<Bogus/>\n    <ima:Linux Executable=\"p2\"/>",
@@ -757,6 +814,53 @@ out:
     if (text != t1)
         free(text);
     free(t1);
+}
+
+/* base_xml with `extra` inserted once before `before`; NULL if that does not apply. */
+static char *with_inserted(const char *before, const char *extra)
+{
+    size_t n = strlen(before) + strlen(extra) + 1;
+    char *to = malloc(n);
+    if (!to)
+        return NULL;
+    snprintf(to, n, "%s%s", extra, before);
+    char *text = replace_once(base_xml, before, to);
+    free(to);
+    return text;
+}
+
+/* Tables of fixed size: one element too many is named, with its place. */
+static void test_limits(void)
+{
+    static char extra[1 << 16];
+    size_t n = 0;
+    for (int i = 0; i < 64; i++) /* p1 has two ports already */
+        n += (size_t)snprintf(extra + n, sizeof extra - n,
+                              "    <Sampling_Port Name=\"X%d\" MaxMessageSize=\"8\" "
+                              "Direction=\"SOURCE\" RefreshRateSeconds=\"1\"/>\n", i);
+    char *text = with_inserted("    <ima:Linux Executable=\"p1\"/>", extra);
+    REQUIRE(text);
+    const char *path = write_module("ports.xml", text);
+    ske_module_cfg_t *m = NULL;
+    ske_diag_t d;
+    CHECK_EQ(ske_config_load(path, &no_resolve, &m, &d), SKE_E_CONFIG);
+    CHECK_STR(d.rule, "at most 64 ports per partition");
+    CHECK_CONTAINS(d.message, "too many ports in partition 'p1'");
+    CHECK_EQ(d.line, line_of(text, "Name=\"X62\""));
+    free(text);
+
+    n = 0;
+    for (int i = 3; i <= 33; i++) /* two already */
+        n += (size_t)snprintf(extra + n, sizeof extra - n,
+                              "  <Partition PartitionIdentifier=\"%d\" PartitionName=\"p%d\">\n"
+                              "    <ima:Linux Executable=\"p\"/>\n  </Partition>\n", i, i);
+    text = with_inserted("  <Module_Schedule", extra);
+    REQUIRE(text);
+    path = write_module("partitions.xml", text);
+    CHECK_EQ(ske_config_load(path, &no_resolve, &m, &d), SKE_E_CONFIG);
+    CHECK_CONTAINS(d.message, "too many partitions");
+    CHECK_EQ(d.line, line_of(text, "PartitionName=\"p33\""));
+    free(text);
 }
 
 static void test_base_module_is_valid(void)
@@ -923,6 +1027,7 @@ int main(int argc, char **argv)
     RUN(test_resolve_executables);
     RUN(test_base_module_is_valid);
     RUN(test_invalid_modules);
+    RUN(test_limits);
     RUN(test_unreadable_inputs);
     RUN(test_diag_format);
     return ske_test_result();

@@ -7,6 +7,7 @@ the report's documented fields; a bad campaign file is refused with the path of 
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -37,6 +38,10 @@ CAMPAIGN = {
     ],
 }
 RUNS = 4
+# Coverage builds (`ima test --coverage`) are flown too, but their instrumented programs are
+# slow enough that the DDS exchange's wall-clock deadlines (docs/dds.md) may be missed in one
+# flight and not in the other: the same verdicts twice are not theirs to promise.
+SAME_VERDICTS = os.environ.get("IMA_COVERAGE") != "1"
 
 
 def _campaign(tmp: Path, **changes) -> Path:
@@ -107,6 +112,8 @@ def test_the_same_campaign_gives_the_same_results_on_dask(first, tmp_path):
     a = [deterministic(r) for r in _records(first)]
     b = [deterministic(r) for r in _records(out)]
     assert [r["run_id"] for r in a] == [r["run_id"] for r in b]
+    if not SAME_VERDICTS:
+        pytest.skip("a coverage build's flights may miss a DDS deadline the other did not")
     for x, y in zip(a, b, strict=True):
         assert x == y, x["run_id"]
 
@@ -139,10 +146,13 @@ def test_rerun_flies_one_run_again_exactly(first):
     run_id = next(k for k in original if "double" in k)
     p = _ima("campaign", "rerun", first, run_id, "--json")
     again = json.loads(p.stdout)
-    assert deterministic(again) == deterministic(original[run_id])
+    assert again["run_id"] == run_id
     assert (first / "rerun" / run_id / "truth.jsonl").is_file()
     p = _ima("campaign", "rerun", first, "no-such-run", check=False)
     assert p.returncode == 2 and "no run 'no-such-run'" in p.stderr
+    if not SAME_VERDICTS:
+        pytest.skip("a coverage build's flights may miss a DDS deadline the other did not")
+    assert deterministic(again) == deterministic(original[run_id])
 
 
 @pytest.mark.parametrize("change, where", [

@@ -34,8 +34,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import mutate  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
-SKE = ROOT / "build" / "ske" / "ima-ske"
-PARTITIONS = ROOT / "build" / "partitions"
+BUILD = Path(os.environ.get("IMA_BUILD_DIR", ROOT / "build"))
+SKE = BUILD / "ske" / "ima-ske"
+PARTITIONS = BUILD / "partitions"
 COUNT = int(os.environ.get("IMA_FUZZ_COUNT", "400"))
 SEED = int(os.environ.get("IMA_FUZZ_SEED", "653"))
 # Shares of the inputs, and of the valid pilot scripts and system models flown (a flight

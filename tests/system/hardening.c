@@ -24,6 +24,12 @@
  *                             mapping of the port memory
  *   Arguments="read"          reads its sampling destination port S_IN once and reports
  *   Arguments="print"         prints a line on its standard output
+ *   Arguments="scribble"      writes garbage where the SKE reads it, through its own mappings:
+ *                             events it could not have sent into its event ring, indices
+ *                             out of range into its queuing source port Q (descriptor 4) and
+ *                             its destination Q1_IN's consumer index; in the next frame an
+ *                             event ring claiming more events than it holds; in the one
+ *                             after, a count of lost events, and it reports "ring in order"
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -40,7 +46,8 @@
 #include "ARINC653.h"
 #include "ske_abi.h"
 
-static ske_ctl_t *ctl; /* "outside" only: its own mapping of the control block */
+static ske_ctl_t *ctl; /* "outside", "scribble": its own mapping of the control block */
+static ske_queue_hdr_t *own_queue; /* "scribble": its own mapping of its queuing port Q */
 
 static void report(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 static void report(const char *fmt, ...)
@@ -118,11 +125,17 @@ __attribute__((constructor(101))) static void before_attach(int argc, char **arg
         if (fd < 0)
             _exit(6);
         close(fd);
-    } else if (strcmp(what, "outside") == 0) {
+    } else if (strcmp(what, "outside") == 0 || strcmp(what, "scribble") == 0) {
         void *m = mmap(NULL, sizeof(ske_ctl_t), PROT_READ | PROT_WRITE, MAP_SHARED, 3, 0);
         if (m == MAP_FAILED)
             _exit(7);
         ctl = m;
+        if (what[0] == 's') {
+            m = mmap(NULL, sizeof *own_queue, PROT_READ | PROT_WRITE, MAP_SHARED, 4, 0);
+            if (m == MAP_FAILED)
+                _exit(7);
+            own_queue = m;
+        }
     } else if (strcmp(what, "truncate") == 0) {
         /* The SKE maps the same memory: shrunk under it, its next access would fault. The
          * library takes the descriptor number out of the environment once attached. */
@@ -213,6 +226,48 @@ static void stamp_future(uint32_t max_size)
                                               (seq & 1u) * ske_slot_stride(max_size));
     slot->t_ns = INT64_MAX / 2;
     report("future: message %u stamped %lld", seq, (long long)slot->t_ns);
+}
+
+/* Puts an event into its ring as the library would, whatever it says. */
+static void put_event(int64_t t_ns, uint32_t kind, int32_t a, int32_t b, uint32_t len,
+                      const char *text)
+{
+    uint32_t head = atomic_load(&ctl->ev_head);
+    ske_event_t *e = &ctl->ev[head % SKE_EVENT_RING];
+    *e = (ske_event_t){.t_ns = t_ns, .kind = kind, .a = a, .b = b, .len = len};
+    size_t n = strlen(text) < sizeof e->text ? strlen(text) : sizeof e->text;
+    memcpy(e->text, text, n);
+    if (n < sizeof e->text)
+        memset(e->text + n, 'x', sizeof e->text - n);
+    atomic_store_explicit(&ctl->ev_head, head + 1, memory_order_release);
+}
+
+static void scribble(void)
+{
+    int64_t now = atomic_load(&ctl->win_start_ns);
+    put_event(now, SKE_EV_MODE, 9, 3, 0, ""); /* no such mode */
+    put_event(now, SKE_EV_PORT_VALIDITY, 42, 1, 0, ""); /* no such port */
+    put_event(now, SKE_EV_HM, 0, 1, SKE_EVENT_TEXT, "no such error");
+    put_event(now, SKE_EV_HM, 2, 1, 3, "short"); /* no room for a process name */
+    put_event(now, 99, 0, 0, 0, ""); /* no such kind */
+    put_event(now + 1000000000000LL, SKE_EV_APP_MESSAGE, 0, 0, 15, "from the future");
+    put_event(now, SKE_EV_APP_MESSAGE, 0, 0, 100000, "long"); /* longer than its text */
+    /* Its source queue claims more messages than it holds; its destination's consumer index
+     * points past what was ever delivered. */
+    atomic_store(&own_queue->head, atomic_load(&own_queue->tail) + 1000);
+    atomic_fetch_add(&ctl->ports[1].rx_tail, 77);
+}
+
+static void scribble_later(void)
+{
+    RETURN_CODE_TYPE rc;
+    PERIODIC_WAIT(&rc); /* released with NORMAL, in the window of the scribbles above */
+    atomic_fetch_add(&ctl->ev_head, SKE_EVENT_RING + 5);
+    PERIODIC_WAIT(&rc);
+    atomic_store(&ctl->ev_dropped, 3);
+    report("ring in order");
+    for (;;)
+        PERIODIC_WAIT(&rc);
 }
 
 /* ---- well-behaved services ----------------------------------------------------------------- */
@@ -332,6 +387,11 @@ int main(int argc, char **argv)
         READ_SAMPLING_MESSAGE(s, buf, &len, &v, &rc);
         report("S_IN: %s %s '%.*s'", rc_name(rc), v == VALID ? "VALID" : "INVALID",
                rc == NO_ERROR ? (int)len : 0, (const char *)buf);
+    } else if (strcmp(mode, "scribble") == 0) {
+        scribble();
+        PARTITION_STATUS_TYPE st;
+        GET_PARTITION_STATUS(&st, &rc);
+        start_process("scribble", scribble_later, st.PERIOD);
     } else if (strcmp(mode, "print") == 0) {
         printf("sys_hardening: a line on standard output\n");
         fflush(stdout);

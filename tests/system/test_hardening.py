@@ -559,3 +559,51 @@ def test_module_time_stops_at_the_end_of_the_clock(run_ske, tmp_path):
     assert times == sorted(times) and times[0] >= 0, times
     assert len(run.of_kind("window_start")) == 1
     assert run.stats["exit_reason"] == "end_of_time"
+
+
+# ---- a partition writes garbage where the SKE reads it --------------------------------------
+
+
+def test_garbage_in_the_shared_memory_is_refused_field_by_field(run_ske, tmp_path):
+    """The scribbler writes, through its own mappings, events it could not have sent, queue
+    indices out of range, then an event ring claiming more than it holds and a count of lost
+    events. The SKE traces only what makes sense (a time outside the window marked suspect,
+    a text cut to its size), drops a source queue's corrupt content with a `port` event,
+    resynchronises a destination's consumer index, skips an impossible ring, and runs on."""
+    frames = 4
+    q = '<Queuing_Port Name="{}" MaxMessageSize="16" Direction="{}" MaxNbMessages="4"/>'
+    module = Module(
+        [
+            Part("scribbler", "scribble", [(0.0, 0.01)], "\n".join(
+                [q.format("Q", "SOURCE"), q.format("Q1_IN", "DESTINATION"),
+                 q.format("Q2_IN", "DESTINATION")])),
+            Part("sink", "qsend", [(0.02, 0.01)], "\n".join(
+                [q.format("Q1", "SOURCE"), q.format("Q2", "SOURCE"),
+                 q.format("Q_IN", "DESTINATION")])),
+        ],
+        [
+            Channel("back", ("scribbler", "Q"), ("sink", "Q_IN")),
+            Channel("one", ("sink", "Q1"), ("scribbler", "Q1_IN")),
+            Channel("two", ("sink", "Q2"), ("scribbler", "Q2_IN")),
+        ],
+    )
+    run = run_ske(module.write(tmp_path, "scribble"), frames=frames)
+    assert_completed(run, frames)
+    mine = [e for e in run.events if e["src"] == "scribbler"]
+    messages = [e for e in mine if e["kind"] == "app_message"]
+    future, long, ordered = messages
+    assert future["text"] == "from the future" and future["suspect_time"] is True, future
+    assert future["t_ns"] == 0 and future["reported_t_ns"] == 1000000000000, future
+    assert long["text"] == "long" + "x" * 124 and "suspect_time" not in long, long
+    assert ordered["text"] == "ring in order" and ordered["t_ns"] == 2 * 50000000, ordered
+    # Nothing else it wrote by hand reached the trace: its modes are the library's own.
+    assert [(e["mode"], e["from"]) for e in mine if e["kind"] == "mode"] == [
+        ("NORMAL", "COLD_START")]
+    assert not [e for e in mine if e["kind"] in ("hm", "port")], mine
+    (corrupt,) = run.of_kind("port", event="corrupt")
+    assert (corrupt["partition"], corrupt["port"], corrupt["t_ns"]) == ("scribbler", "Q", 10000000)
+    (dropped,) = run.of_kind("events_dropped")
+    assert (dropped["partition"], dropped["count"]) == ("scribbler", 3), dropped
+    # The sink's messages reached the scribbler's queues, the corrupt index notwithstanding.
+    assert run.app_messages("sink") == ["sent at 20000000"]
+    assert not run.of_kind("port", event="overflow")

@@ -157,6 +157,89 @@ static void agent(int lfd)
     close(fd);
 }
 
+/* ---- joins that fail: each says why, and leaves the client unconnected ---------------- */
+
+static int listen_at(const char *path)
+{
+    int lfd = socket(AF_UNIX, SOCK_SEQPACKET, 0);
+    struct sockaddr_un sa = {.sun_family = AF_UNIX};
+    snprintf(sa.sun_path, sizeof sa.sun_path, "%s", path);
+    unlink(path);
+    if (lfd < 0 || bind(lfd, (struct sockaddr *)&sa, sizeof sa) != 0 || listen(lfd, 1) != 0)
+        return -1;
+    return lfd;
+}
+
+/* An agent that takes the hello, then answers `reply` (len bytes; none: it hangs up). */
+static pid_t bad_agent(const char *path, const void *reply, size_t len)
+{
+    int lfd = listen_at(path);
+    CHECK(lfd >= 0);
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        int fd = accept(lfd, NULL, NULL);
+        struct xch_hdr h;
+        if (fd < 0 || recv(fd, &h, sizeof h, 0) != (ssize_t)sizeof h)
+            _exit(1);
+        if (len)
+            send(fd, reply, len, 0);
+        close(fd);
+        _exit(0);
+    }
+    close(lfd);
+    return pid;
+}
+
+static void check_refused(const char *path, unsigned node, int rc_expected, const char *says)
+{
+    xch_client_t c;
+    char err[256] = "";
+    int rc = xch_client_connect(&c, path, node, err, sizeof err);
+    CHECK(rc == rc_expected);
+    CHECK(strstr(err, says) != NULL);
+    CHECK(c.fd == -1);
+    if (rc != rc_expected || !strstr(err, says))
+        fprintf(stderr, "  got %d '%s', expected %d '%s'\n", rc, err, rc_expected, says);
+}
+
+static void test_joins_that_fail(const char *path)
+{
+    check_refused(path, 0, -EINVAL, "node 0 out of range 1..3");
+    check_refused(path, 4, -EINVAL, "node 4 out of range");
+    check_refused("", 1, -ENAMETOOLONG, "socket path missing");
+    char longpath[200];
+    memset(longpath, 'x', sizeof longpath - 1);
+    longpath[sizeof longpath - 1] = '\0';
+    check_refused(longpath, 1, -ENAMETOOLONG, "longer than");
+    unlink(path);
+    check_refused(path, 1, -ENOENT, "cannot connect to the DDS agent at");
+
+    pid_t pid = bad_agent(path, NULL, 0);
+    check_refused(path, 2, -ESHUTDOWN, "it closed the connection");
+    waitpid(pid, NULL, 0);
+    struct xch_hdr other = {XCH_MAGIC, XCH_VERSION, XCH_WELCOME, 1, 3, 0}; /* node 1's */
+    pid = bad_agent(path, &other, sizeof other);
+    check_refused(path, 2, -EPROTO, "did not answer with a welcome for node 2");
+    waitpid(pid, NULL, 0);
+    struct xch_hdr no_nodes = {XCH_MAGIC, XCH_VERSION, XCH_WELCOME, 2, 0, 0};
+    pid = bad_agent(path, &no_nodes, sizeof no_nodes);
+    check_refused(path, 2, -EPROTO, "did not answer with a welcome");
+    waitpid(pid, NULL, 0);
+
+    /* Not connected: nothing to send on or wait for. */
+    xch_client_t c;
+    char err[64];
+    (void)xch_client_connect(&c, path, 9, err, sizeof err);
+    struct xch_agreed g;
+    struct xch_inputs in = {0};
+    CHECK(xch_client_send(&c, XCH_HEALTH, 1, 0, &in, sizeof(struct xch_health)) == -ENOTCONN);
+    CHECK(xch_client_await(&c, 1, &g, 0) == -ENOTCONN);
+    CHECK(xch_client_exchange(&c, 1, 0, &in, &g) == -ENOTCONN);
+    xch_client_close(&c);
+    unlink(path);
+}
+
 int main(void)
 {
     char dir[] = "/tmp/xch-client-XXXXXX";
@@ -164,16 +247,15 @@ int main(void)
         return 1;
     char path[64];
     snprintf(path, sizeof path, "%s/xch.sock", dir);
-    int lfd = socket(AF_UNIX, SOCK_SEQPACKET, 0);
-    struct sockaddr_un sa = {.sun_family = AF_UNIX};
-    snprintf(sa.sun_path, sizeof sa.sun_path, "%s", path);
-    if (lfd < 0 || bind(lfd, (struct sockaddr *)&sa, sizeof sa) != 0 || listen(lfd, 1) != 0)
+    test_joins_that_fail(path);
+    int lfd = listen_at(path);
+    if (lfd < 0)
         return 1;
     fflush(NULL);
     pid_t pid = fork();
     if (pid == 0) {
         close(lfd);
-        _exit(child(path));
+        exit(child(path)); /* exit, not _exit: a coverage build writes the child's counters */
     }
     agent(lfd);
     int st = 0;

@@ -11,7 +11,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from ima import paths
+from ima import code_coverage, paths
 from ima.errors import ImaError
 
 # pytest's documented exit codes (pytest.ExitCode), without importing pytest here.
@@ -61,8 +61,9 @@ def summary(outcomes: Sequence[Outcome]) -> tuple[str, int]:
 
 
 # The unit tests, built a second time with AddressSanitizer and UndefinedBehaviorSanitizer.
-SANITIZED_TARGETS = ("test_config", "test_port_buf", "test_plan", "test_hm",
+SANITIZED_TARGETS = ("test_config", "test_port_buf", "test_plan", "test_hm", "test_create",
                      "test_sandbox_policy", "test_canbus_wire", "test_canbus_socket",
+                     "test_canbus_client", "test_canbus_wire_oom",
                      "nav_fcs_test_nf_math", "nav_fcs_test_nav", "nav_fcs_test_fcs",
                      "io_test_settings", "io_test_can_rx", "io_test_can_tx", "io_test_redundancy",
                      "test_fi_spec", "test_voter", "test_canbus_fault", "test_fi_wrong_output",
@@ -115,6 +116,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "--fuzz-long", nargs="?", type=int, const=FUZZ_LONG, default=None, metavar="N",
         help=f"only the fuzzing of the inputs, with N inputs (default {FUZZ_LONG:,}; the "
         "suite's share is 400); its counts go to build/fuzz-long.json")
+    only.add_argument(
+        "--coverage", action="store_true",
+        help="line and branch coverage (gcovr) of ske/, health_monitor/ and nodes/: ctest and "
+        "pytest against an instrumented build in build-coverage/, figures per component "
+        "printed and written to build-coverage/coverage.json")
     parser.add_argument(
         "--no-sanitize",
         action="store_true",
@@ -184,8 +190,49 @@ def _run_fuzz_long(root: Path, count: int) -> int:
     return 0 if outcome.ok else 1
 
 
+def _build_coverage(root: Path, build: Path) -> bool:
+    log = build / "ima-build.log"
+    build.mkdir(parents=True, exist_ok=True)
+    print(f"ima: building the instrumented tree in {build} (log: {log})", flush=True)
+    with log.open("w") as f:
+        for cmd in code_coverage.configure_commands(root, build):
+            if subprocess.run(cmd, cwd=root, stdout=f, stderr=subprocess.STDOUT).returncode:
+                print(f"ima: the coverage build failed (log: {log})", file=sys.stderr)
+                print(log.read_text()[-3000:], file=sys.stderr)
+                return False
+    return True
+
+
+def _run_coverage(root: Path, keyword: str | None) -> int:
+    """The C and Python tests against build-coverage/ (gcov counters in every program the
+    tests run, partitions included), then gcovr's figures per component."""
+    build = root / "build-coverage"
+    if not _build_coverage(root, build):
+        return 1
+    code_coverage.reset_counters(build)
+    outcomes = [_run_ctest(root, build)]
+    # The tests, and the ./ima they call, find the programs in the build tree these name.
+    env = dict(os.environ, IMA_BUILD_DIR=str(build), IMA_PARTITION_PATH=str(build / "partitions"),
+               IMA_COVERAGE="1")
+    cmd = pytest_command(sys.executable, paths.tests_dir(), keyword, env)
+    outcomes.append(pytest_outcome(subprocess.run(cmd, cwd=root, env=env).returncode))
+    gcovr = code_coverage.gcovr_command(sys.executable, root, build)
+    if subprocess.run(gcovr, cwd=root, stdout=subprocess.DEVNULL).returncode != 0:
+        outcomes.append(Outcome("gcovr", False, f"failed: {' '.join(gcovr)}"))
+    else:
+        report, figures = code_coverage.write_report(build)
+        print(code_coverage.table(figures))
+        print(f"ima: coverage per component in {report}; per file in "
+              f"{build / code_coverage.FILES_REPORT} and {build / 'coverage-files.txt'}")
+    line, code = summary(outcomes)
+    print(line)
+    return code
+
+
 def run(args: argparse.Namespace) -> int:
     root = paths.repo_root()
+    if args.coverage:
+        return _run_coverage(root, args.keyword)
     if args.fuzz_long is not None:
         if args.fuzz_long < 1:
             raise ImaError("--fuzz-long N: at least one input", exit_code=2)

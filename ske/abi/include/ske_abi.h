@@ -32,6 +32,13 @@
  * OutputFile), which the SKE opened for it: the only file it may write. */
 #define SKE_ENV_OUTPUT_FD "IMA_OUTPUT_FD"
 
+#ifdef IMA_COVERAGE
+/* Coverage builds only (cmake -DIMA_COVERAGE=ON): the signal by which ima-ske asks a
+ * partition's process to write its gcov counters and exit, before it kills it (a SIGKILL
+ * alone would lose them). Its number, 12 on Linux: SIGUSR2. */
+#define SKE_COVERAGE_SIGNAL 12
+#endif
+
 typedef enum {
     SKE_TIME_EMULATED = 0,
     SKE_TIME_REALTIME = 1,

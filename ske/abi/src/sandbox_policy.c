@@ -12,6 +12,7 @@
 #include <sys/ioctl.h>
 #include <sys/mman.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
 
@@ -89,6 +90,9 @@ typedef struct {
     bool ja_deny[BODY_MAX];
     unsigned n;
     bool overflow;
+#ifdef IMA_COVERAGE
+    bool fall_through; /* a call whose arguments do not match goes on to the later rules */
+#endif
 } body_t;
 
 static void body_emit(body_t *b, uint16_t code, uint32_t k, int jt, int jf)
@@ -162,7 +166,12 @@ static void body_close(prog_t *p, body_t *b, long nr)
     unsigned allow_at = b->n;
     body_emit(b, BPF_RET | BPF_K, RET_ALLOW, 0, 0);
     unsigned deny_at = b->n;
-    body_emit(b, BPF_RET | BPF_K, RET_DENY(SKE_SANDBOX_DENIED_ARGS), 0, 0);
+#ifdef IMA_COVERAGE
+    if (b->fall_through) /* the call number again, for the rules behind this one */
+        body_load(b, offsetof(struct seccomp_data, nr));
+    else
+#endif
+        body_emit(b, BPF_RET | BPF_K, RET_DENY(SKE_SANDBOX_DENIED_ARGS), 0, 0);
     if (b->overflow || b->n > 255) {
         p->overflow = true;
         return;
@@ -346,6 +355,31 @@ static void io_calls(prog_t *p)
         allow(p, any[i]);
 }
 
+#ifdef IMA_COVERAGE
+/* Coverage builds only (cmake -DIMA_COVERAGE=ON): what libgcov needs to merge the process's
+ * counters into its .gcda files when it exits or dumps them (ske/apex/src/coverage.c). First
+ * in the program; a call they do not allow goes on to the partition's own rules. Normal
+ * builds have none of these. */
+static void rule_or_next(prog_t *p, long nr, const cond_t *c)
+{
+    body_t b = {.n = 0, .fall_through = true};
+    body_cond(&b, c);
+    body_close(p, &b, nr);
+}
+
+static void coverage_calls(prog_t *p)
+{
+    const cond_t gcda_open = in1(2, O_RDWR | O_CREAT); /* libgcov's open of a .gcda file */
+    const cond_t gcda_lock = {1, C_IN, 2, {F_SETLKW, F_GETFL}};
+    const cond_t fsize = in1(1, RLIMIT_FSIZE); /* lifted before the dump */
+    rule_or_next(p, SYS_openat, &gcda_open);
+    rule_or_next(p, SYS_fcntl, &gcda_lock);
+    rule_or_next(p, SYS_prlimit64, &fsize);
+    allow(p, SYS_read);
+    allow(p, SYS_write);
+}
+#endif
+
 /* What the program loader, the C library's start-up and the APEX library's attachment need
  * before the RUN filter is in place. */
 static void load_calls(prog_t *p, const ske_sandbox_policy_t *pol, bool io)
@@ -411,6 +445,9 @@ int ske_sandbox_build(const ske_sandbox_policy_t *pol, ske_sandbox_stage_t stage
     /* x32 calls carry the native architecture and a flag bit in their number. */
     emit(&p, BPF_JMP | BPF_JGE | BPF_K, 0x40000000u, 0, 1);
     ret(&p, RET_DENY(SKE_SANDBOX_DENIED_ABI));
+#endif
+#ifdef IMA_COVERAGE
+    coverage_calls(&p);
 #endif
     common_calls(&p, pol, io, load_stage);
     if (io)

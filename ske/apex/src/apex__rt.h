@@ -197,6 +197,10 @@ void apex__service_port_waiters(void);
  * service call once rt->fault_due has come; and the write of a sampling port under an
  * output fault (true: done, false: write normally). */
 void apex__faults_init(void);
+#ifdef IMA_COVERAGE
+/* Coverage builds only (coverage.c): writes the gcov counters on SKE_COVERAGE_SIGNAL. */
+void apex__coverage_init(void);
+#endif
 void apex__fault_point(void);
 bool apex__fault_write(int k, const APEX_BYTE *msg, MESSAGE_SIZE_TYPE len);
 /* Messages waiting in a queuing port, and whether any process waits on it. */

@@ -101,6 +101,9 @@ __attribute__((constructor(101))) static void apex_attach(void)
     apex__ports_attach();
     apex__hm_init();
     apex__faults_init();
+#ifdef IMA_COVERAGE
+    apex__coverage_init();
+#endif
     if (apex__sandbox_install(rt->ctl) != 0)
         fatal("apex: cannot install the partition's system-call filter");
     atomic_store(&rt->ctl->ready, 1);

@@ -1,0 +1,132 @@
+# SPDX-License-Identifier: Apache-2.0
+"""ima-canbus against clients that break its protocol (nodes/include/canbus/proto.h): hellos
+it refuses and why, records it rejects one by one, a client sending only garbage, joins past
+the start or past --max-clients; the run goes on and ends on a client's STOP."""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import subprocess
+import time
+from pathlib import Path
+
+from ima.canbus import proto
+
+ROOT = Path(__file__).resolve().parents[2]
+BUS = Path(os.environ.get("IMA_BUILD_DIR", ROOT / "build")) / "nodes" / "ima-canbus"
+
+
+def _connect(path: Path) -> socket.socket:
+    for _ in range(100):  # the socket file appears just before the bus listens on it
+        s = socket.socket(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+        s.settimeout(20)
+        try:
+            s.connect(str(path))
+            return s
+        except ConnectionRefusedError:
+            s.close()
+            time.sleep(0.02)
+    raise AssertionError(f"nobody listens at {path}")
+
+
+def _join(path: Path, name: str, roles: int) -> tuple[socket.socket, bytes]:
+    s = _connect(path)
+    s.send(proto.pack_hello(name, roles))
+    return s, s.recv(proto.MAX_DATAGRAM)
+
+
+def _refused(answer: bytes) -> int:
+    (rec,) = proto.unpack_recs(answer)
+    assert rec.type == proto.MSG_STOP, rec
+    return rec.id
+
+
+def _next_tick(s: socket.socket) -> int:
+    while True:
+        for rec in proto.unpack_recs(s.recv(proto.MAX_DATAGRAM)):
+            if rec.type == proto.MSG_TICK:
+                return rec.t_ns
+
+
+def test_what_the_bus_refuses_and_rejects(tmp_path):
+    sock, trace, stats = tmp_path / "can.sock", tmp_path / "can.jsonl", tmp_path / "can.json"
+    bus = subprocess.Popen([str(BUS), "--socket", str(sock), "--lockstep-clients", "1",
+                            "--max-clients", "3", "--max-rejects", "8", "--trace", str(trace),
+                            "--stats", str(stats), "-q"], stderr=subprocess.PIPE, text=True)
+    clients = []
+    try:
+        for _ in range(400):
+            if sock.exists() or bus.poll() is not None:
+                break
+            time.sleep(0.05)
+        # Hellos it refuses: the wrong size, magic or roles.
+        s = _connect(sock)
+        s.send(b"hi")
+        assert _refused(s.recv(proto.MAX_DATAGRAM)) == proto.STOP_BAD_HELLO
+        assert s.recv(proto.MAX_DATAGRAM) == b""  # and closed
+        s.close()
+        s = _connect(sock)
+        s.send(proto.HELLO.pack(0xDEAD, proto.VERSION, proto.ROLE_CAN, b"x", 0, 0))
+        assert _refused(s.recv(proto.MAX_DATAGRAM)) == proto.STOP_BAD_HELLO
+        s.close()
+        s, answer = _join(sock, "odd", 0x80)
+        assert _refused(answer) == proto.STOP_BAD_HELLO
+        s.close()
+        # The one lockstep client: the run starts.
+        node, answer = _join(sock, "node1", proto.ROLE_CAN | proto.ROLE_LOCKSTEP)
+        clients.append(node)
+        assert proto.unpack_welcome(answer).client == 0
+        t_next = _next_tick(node)
+        late, answer = _join(sock, "node2", proto.ROLE_LOCKSTEP)
+        assert _refused(answer) == proto.STOP_LATE_JOIN
+        late.close()
+        logger, answer = _join(sock, "logger", proto.ROLE_OWN)  # receives, may not send
+        clients.append(logger)
+        noisy, answer = _join(sock, "noisy", proto.ROLE_CAN)
+        clients.append(noisy)
+        full, answer = _join(sock, "fourth", proto.ROLE_CAN)
+        assert _refused(answer) == proto.STOP_FULL
+        full.close()
+        # Records it rejects, one by one; the clamped frame goes on the wire.
+        logger.send(proto.pack_frame(0x100, b"\x01", 0, extended=False))
+        node.send(b"".join([
+            proto.REC.pack(proto.MSG_FRAME, 0, 9, 0, 0x100, t_next, 0, bytes(8)),
+            proto.REC.pack(proto.MSG_FRAME, 0x80, 1, 0, 0x100, t_next, 0, bytes(8)),
+            proto.pack_frame(0x800, b"\x02", t_next, extended=False),
+            proto.pack_frame(0x123, b"\x03", 0, extended=False),  # before its quantum
+            proto.pack_rec(proto.MSG_DONE, t_ns=t_next + 1),
+            proto.pack_rec(99),
+            proto.pack_rec(proto.MSG_FAULT),
+        ]))
+        node.send(b"\x00" * 33)
+        noisy.send(proto.pack_rec(77) * 9)  # past --max-rejects 8: dropped
+        node.send(proto.pack_rec(proto.MSG_DONE, t_ns=t_next))
+        _next_tick(node)
+        node.send(proto.pack_rec(proto.MSG_STOP, id_=proto.STOP_REQUESTED))
+        assert bus.wait(timeout=30) == 0, bus.stderr.read()
+    finally:
+        for c in clients:
+            c.close()
+        if bus.poll() is None:
+            bus.kill()
+            bus.wait()
+        bus.stderr.close()
+    st = json.loads(stats.read_text())
+    assert (st["bad_hellos"], st["late_joins"], st["refused_full"]) == (3, 1, 1), st
+    assert st["rejected"] == 1 + 7 + 9 and st["garbage_disconnects"] == 1, st
+    lines = [json.loads(line) for line in trace.read_text().splitlines()]
+    rejects = [(e.get("name"), e["reason"]) for e in lines if e["kind"] == "reject"]
+    assert rejects == [
+        ("", "bad_hello"), ("x", "bad_hello"), ("odd", "bad_hello"), ("node2", "late_join"),
+        ("fourth", "full"), ("node1", "len"), ("node1", "flags"), ("node1", "id"),
+        ("node1", "bad_done"), ("node1", "type"), ("node1", "fault_records_off"),
+        ("node1", "size"), ("logger", "frame_without_can_role"),
+        *[("noisy", "type")] * 9,
+    ], rejects
+    left = [(e["name"], e["reason"]) for e in lines if e["kind"] == "client_leave"]
+    assert ("noisy", "garbage") in left, left
+    assert [e["by"] for e in lines if e["kind"] == "stop_request"] == ["node1"]
+    (frame,) = [e for e in lines if e["kind"] == "can_tx"]
+    assert (frame["id"], frame["from"], frame["start_ns"]) == (0x123, "node1", 0), frame

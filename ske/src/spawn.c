@@ -169,18 +169,27 @@ static void child_exec(ske_t *s, ske_part_t *p, int errpipe, char **envp)
     }
     if (s->trace.f == stdout)
         dup2(2, 1); /* keep the JSON-lines trace on standard output clean */
-    /* Move every descriptor the partition gets above the target range, then into place:
-     * 3 = control block, 4.. = its ports, then the exec-error pipe; close the rest. */
+    /* Move every descriptor the partition gets above the target range (3 .. 5 + the most
+     * ports), then into place: 3 = control block, 4.. = its ports, then the exec-error pipe;
+     * close the rest. Just above the range, so that the usual 1024-descriptor limit is no
+     * limit here; a copy that cannot be made is the partition's start failing. */
     int high[SKE_MAX_PORTS + 2];
-    const int base = 1024;
-    high[0] = fcntl(p->ctl_fd, F_DUPFD, base);
+    const int base = SKE_MAX_PORTS + 6;
+    bool moved = (high[0] = fcntl(p->ctl_fd, F_DUPFD, base)) >= 0;
     for (int k = 0; k < n; k++) {
         const ske_portmem_t *pm = &p->ports[k];
         int src = p->cfg->ports[k].dir == SKE_DIR_DESTINATION ? pm->fd_ro : pm->fd;
-        high[1 + k] = fcntl(src, F_DUPFD, base);
+        moved &= (high[1 + k] = fcntl(src, F_DUPFD, base)) >= 0;
     }
-    high[1 + n] = fcntl(errpipe, F_DUPFD_CLOEXEC, base);
+    moved &= (high[1 + n] = fcntl(errpipe, F_DUPFD_CLOEXEC, base)) >= 0;
     int out_high = p->output_fd >= 0 ? fcntl(p->output_fd, F_DUPFD, base) : -1;
+    moved &= p->output_fd < 0 || out_high >= 0;
+    if (!moved) {
+        int e = errno;
+        ssize_t wc = write(errpipe, &e, sizeof e);
+        (void)wc;
+        _exit(127);
+    }
     for (int k = 0; k <= n; k++)
         dup2(high[k], 3 + k);
     dup2(high[1 + n], 4 + n);

@@ -4,6 +4,7 @@ documented status (2 usage, invalid module or fault; 1 run-time failure), runs n
 
 from __future__ import annotations
 
+import json
 import os
 import resource
 import subprocess
@@ -123,3 +124,18 @@ def test_too_few_descriptors_stop_the_start_with_one_line(ske_binary):
         if kind.startswith("cannot start"):
             break
     assert all(kinds.values()), kinds
+
+
+def test_the_usual_descriptor_limit_of_1024_is_enough(ske_binary):
+    """Many systems start processes with at most 1024 descriptors: every partition starts and
+    runs under that limit (each is handed its descriptors just above its own range)."""
+    def limit():
+        resource.setrlimit(resource.RLIMIT_NOFILE, (1024, 1024))
+
+    env = dict(os.environ, IMA_PARTITION_PATH=str(PARTITIONS))
+    p = subprocess.run([str(ske_binary), "--frames", "5", "-q", "--stats", "/dev/stdout",
+                        str(EXAMPLE)], capture_output=True, text=True, timeout=60, env=env,
+                       preexec_fn=limit)
+    assert p.returncode == 0, p.stderr
+    stats = json.loads(p.stdout)
+    assert stats["frames"] == 5 and stats["hm_events"] == 0, stats

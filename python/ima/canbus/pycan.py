@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """python-can interface "ima": attach python-can tools (logger, viewer, player, cantools monitor)
-to the live virtual CAN bus, e.g. `python -m can.logger -i ima -c RUN/can.sock`."""
+to the live virtual CAN bus, e.g. `python -m can.logger -i ima -c RUN/can.sock`. A launched
+run's bus admits them listen-only (they are not among its declared clients): they receive every
+frame, and sending raises; a bus started by hand takes their frames too."""
 
 from __future__ import annotations
 

@@ -97,8 +97,10 @@ class Agent:
 
 
 def start_agent(node: int, nodes: int, run_dir: Path, domain: int, *, realtime: bool = False,
-                extra: list[str] | tuple = (), wait: bool = False) -> Agent:
-    """Starts node's agent with its socket, trace, statistics and stderr in run_dir."""
+                extra: list[str] | tuple = (), wait: bool = False,
+                fds: tuple[int, ...] = ()) -> Agent:
+    """Starts node's agent with its socket, trace, statistics and stderr in run_dir; `fds`
+    are inherited (e.g. --ske-pid-fd's)."""
     run_dir = Path(run_dir)
     sock = run_dir / f"xch{node}.sock"
     trace = run_dir / f"dds{node}.jsonl"
@@ -111,9 +113,9 @@ def start_agent(node: int, nodes: int, run_dir: Path, domain: int, *, realtime: 
         args.append("--realtime")
     args += [str(a) for a in extra]
     try:
-        pass_fds = (domain_lock_fd(domain),)
+        pass_fds = (domain_lock_fd(domain), *fds)
     except ImaError:
-        pass_fds = ()
+        pass_fds = tuple(fds)
     with open(err, "wb") as errf:
         proc = subprocess.Popen(args, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                 stderr=errf, env=dds_env(), pass_fds=pass_fds)

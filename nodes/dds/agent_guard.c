@@ -88,7 +88,8 @@ static void refuse(agent_t *a, const char *kind, const struct ucred *cred, pid_t
                  "SKE (pid %ld)", (long)cred->pid, comm, (long)ppid, a->node_name,
                  (long)a->ske_pid);
     agent_refused_add(a, "io_client", detail);
-    if (agent_trace_begin(a, kind)) {
+    /* A flood of connections is counted, not traced line by line. */
+    if (a->io_refused <= AGENT_REFUSED_MAX && agent_trace_begin(a, kind)) {
         fprintf(a->trace, ",\"pid\":%ld,\"uid\":%ld", (long)cred->pid, (long)cred->uid);
         if (ppid)
             fprintf(a->trace, ",\"parent\":%ld", (long)ppid);

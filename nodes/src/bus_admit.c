@@ -134,7 +134,8 @@ void canbus__sb_refused(canbus_bus_t *b, canbus_sbuf_t *s)
 {
     canbus_sb_str(s, "[");
     bool first = b->refused.n == 0;
-    canbus_sb_mem(s, b->refused.p, b->refused.n);
+    if (!first)
+        canbus_sb_mem(s, b->refused.p, b->refused.n);
     char detail[256];
     if (b->n_refused > REFUSED_LISTED_MAX) {
         snprintf(detail, sizeof detail, "%zu more refused hellos", b->n_refused - REFUSED_LISTED_MAX);

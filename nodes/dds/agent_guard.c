@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "agent__agent.h"
+#include "peer/parent.h"
 
 void agent_refused_add(agent_t *a, const char *what, const char *detail)
 {
@@ -50,31 +51,6 @@ void agent_guard_read_ske(agent_t *a)
     }
 }
 
-/* The parent of a process and its command name, from /proc/PID/stat; -1 if it is gone. */
-static pid_t parent_of(pid_t pid, char *comm, size_t len)
-{
-    char path[64], buf[512];
-    snprintf(path, sizeof path, "/proc/%ld/stat", (long)pid);
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return -1;
-    ssize_t n = read(fd, buf, sizeof buf - 1);
-    close(fd);
-    if (n <= 0)
-        return -1;
-    buf[n] = '\0';
-    /* PID (COMM) STATE PPID ...: the name may hold spaces and parentheses, the last ')' ends it */
-    char *open_p = strchr(buf, '('), *close_p = strrchr(buf, ')');
-    if (!open_p || !close_p || close_p < open_p)
-        return -1;
-    snprintf(comm, len, "%.*s", (int)(close_p - open_p - 1), open_p + 1);
-    char state;
-    long ppid;
-    if (sscanf(close_p + 1, " %c %ld", &state, &ppid) != 2)
-        return -1;
-    return (pid_t)ppid;
-}
-
 static void refuse(agent_t *a, const char *kind, const struct ucred *cred, pid_t ppid,
                    const char *comm)
 {
@@ -108,7 +84,7 @@ bool agent_guard_may_be_io(agent_t *a, int fd)
     if (a->ske_pid == 0 && a->o.ske_pid_fd < 0)
         return true; /* started by hand, without --ske-pid-fd: the owner's processes */
     char comm[64] = "?";
-    pid_t ppid = parent_of(cred.pid, comm, sizeof comm);
+    pid_t ppid = peer_parent(cred.pid, comm, sizeof comm);
     if (a->ske_pid > 0 && ppid == a->ske_pid)
         return true;
     refuse(a, "io_refused_process", &cred, ppid, comm);

@@ -6,10 +6,14 @@
 #include "canbus__server.h"
 
 #include <inttypes.h>
+#include <poll.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "peer/parent.h"
+
 #define REFUSED_LISTED_MAX 64 /* refused hellos listed one by one; later ones only counted */
+#define PROCESS_WAIT_NS 2000000000LL /* how long a declared hello waits for its node's pid */
 
 /* A name is 1..31 printable ASCII characters and its NUL: it goes into traces and summaries. */
 static bool name_ok(const char *name)
@@ -23,7 +27,7 @@ static bool name_ok(const char *name)
     return true;
 }
 
-static const canbus_decl_t *declared(const canbus_bus_t *b, const char *name)
+static canbus_decl_t *declared(const canbus_bus_t *b, const char *name)
 {
     for (size_t i = 0; i < b->o.n_decls; i++)
         if (strcmp(b->o.decls[i].name, name) == 0)
@@ -57,6 +61,47 @@ static canbus_client_t *live_named(canbus_bus_t *b, const char *name)
     return NULL;
 }
 
+bool canbus__declare_process(canbus_bus_t *b, uint32_t node, pid_t pid)
+{
+    bool any = false;
+    for (size_t i = 0; i < b->o.n_decls; i++)
+        if (b->o.decls[i].node == node) {
+            b->o.decls[i].pid = pid;
+            any = true;
+        }
+    return any;
+}
+
+/* The launcher names a node's process as soon as it has started it, but the process may say
+ * hello first: the control channel is read until the name comes, for a bounded time (this
+ * happens before the start, while the launcher starts the nodes and the world). */
+static void await_process(canbus_bus_t *b, const canbus_decl_t *d)
+{
+    int64_t end = canbus__wall_ns() + PROCESS_WAIT_NS;
+    for (int64_t now; !d->pid && b->control && !b->control->gone &&
+                      (now = canbus__wall_ns()) < end;) {
+        struct pollfd p = {.fd = b->control->fd, .events = POLLIN};
+        if (poll(&p, 1, (int)((end - now) / 1000000) + 1) > 0)
+            canbus__read_client(b, b->control);
+    }
+}
+
+/* A declared client of a node whose process the launcher named must be that process or one of
+ * its children (a SKE's partitions): a same-user process cannot take a declared name. */
+static const char *check_process(canbus_bus_t *b, const canbus_client_t *c,
+                                 const canbus_decl_t *d)
+{
+    if (!b->control)
+        return NULL; /* started by hand: nobody names the processes */
+    await_process(b, d);
+    if (!d->pid)
+        return "unknown_process";
+    char comm[64];
+    if (c->pid == d->pid || (c->pid > 0 && peer_parent(c->pid, comm, sizeof comm) == d->pid))
+        return NULL;
+    return "not_its_process";
+}
+
 const char *canbus__admit(canbus_bus_t *b, canbus_client_t *c, const struct canbus_hello *h,
                           uint32_t *stop_reason)
 {
@@ -70,7 +115,8 @@ const char *canbus__admit(canbus_bus_t *b, canbus_client_t *c, const struct canb
         return NULL; /* a bus started by hand: everyone is trusted as before */
     const canbus_decl_t *d = declared(b, c->name);
     if (d)
-        return d->roles == h->roles && d->node == h->node ? NULL : "not_as_declared";
+        return d->roles != h->roles || d->node != h->node ? "not_as_declared"
+                                                          : check_process(b, c, d);
     if (h->roles & CANBUS_ROLE_LOCKSTEP)
         return "undeclared_lockstep"; /* it would hold up, or take part in, the quanta */
     if (!node_exists(b, h->node))
@@ -106,8 +152,8 @@ void canbus__refuse_record(canbus_bus_t *b, canbus_client_t *c, uint8_t type, co
     canbus__reject(b, c, why);
 }
 
-static const char *const type_names[8] = {"other", "FRAME", "TICK", "DONE",
-                                          "STOP",  "ERROR", "FAULT", "other"};
+static const char *const type_names[8] = {"other", "FRAME", "TICK",  "DONE",
+                                          "STOP",  "ERROR", "FAULT", "PROCESS"};
 
 /* "'NAME' (client K, listen-only, pid P): refused 3 FRAME, 1 STOP", or "" when it sent
  * nothing it may not. */
@@ -118,11 +164,11 @@ static void client_detail(const canbus_client_t *c, char *out, size_t len)
                      c->listen_only ? ", listen-only" : "", (long)c->pid);
     const char *sep = " ";
     bool any = false;
-    for (int t = 1; t < 8 && n > 0 && (size_t)n < len; t++) {
-        uint64_t k = c->refused_types[t] + (t == 7 ? c->refused_types[0] : 0);
+    for (int t = 1; t <= 8 && n > 0 && (size_t)n < len; t++) {
+        uint64_t k = c->refused_types[t % 8]; /* 0, others, last */
         if (!k)
             continue;
-        n += snprintf(out + n, len - (size_t)n, "%s%" PRIu64 " %s", sep, k, type_names[t]);
+        n += snprintf(out + n, len - (size_t)n, "%s%" PRIu64 " %s", sep, k, type_names[t % 8]);
         sep = ", ";
         any = true;
     }

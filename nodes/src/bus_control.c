@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The launcher's control channel (--control-fd): one end of a socketpair the bus inherits,
- * never a path, so that only the process that started the bus can arm faults (FAULT records)
- * or end the run with stopped_by "launcher" (STOP). It is kept in the live list like a client
+ * never a path, so that only the process that started the bus can arm faults (FAULT records),
+ * end the run with stopped_by "launcher" (STOP) or name the process of a node (PROCESS). It is kept in the live list like a client
  * without an index: polled and read with the others, delivered nothing but the final STOP. */
 #include "canbus__server.h"
 
@@ -40,6 +40,7 @@ int canbus__control_open(canbus_bus_t *b)
     strcpy(c->name, "launcher");
     canbus_sb_str(&c->jname, LAUNCHER);
     b->live[b->n_live++] = c; /* first: read before any client in the same poll */
+    b->control = c;
     return 0;
 }
 
@@ -112,6 +113,10 @@ void canbus__handle_control(canbus_bus_t *b, canbus_client_t *c, const uint8_t *
         switch (r.type) {
         case CANBUS_MSG_STOP: canbus__stop_by(b, c); break;
         case CANBUS_MSG_FAULT: arm_fault(b, &r); break;
+        case CANBUS_MSG_PROCESS:
+            if (r.t_ns <= 1 || r.t_ns > INT32_MAX || !canbus__declare_process(b, r.id, (pid_t)r.t_ns))
+                control_reject(b, "bad_process");
+            break;
         default: control_reject(b, "type"); break;
         }
     }

@@ -233,7 +233,8 @@ void canbus__handle_records(canbus_bus_t *b, canbus_client_t *c, const uint8_t *
             else
                 canbus__refuse_record(b, c, r.type, "control_record");
             break;
-        case CANBUS_MSG_FAULT: /* only the launcher arms faults, over its own channel */
+        case CANBUS_MSG_FAULT: /* only the launcher arms faults and names processes, */
+        case CANBUS_MSG_PROCESS: /* over its own channel */
             canbus__refuse_record(b, c, r.type, "control_record");
             break;
         default: canbus__reject(b, c, "type"); break;

@@ -53,6 +53,7 @@ typedef struct canbus_decl {
     char name[CANBUS_NAME_LEN];
     uint16_t roles;
     uint32_t node;
+    pid_t pid; /* its node's process (a PROCESS record on the control channel), 0 not yet */
 } canbus_decl_t;
 
 typedef struct canbus_opts {
@@ -139,6 +140,7 @@ typedef struct canbus_bus {
     canbus_sbuf_t refused;  /* the statistics' `refused` entries of refused hellos */
     size_t n_refused;
     canbus_sbuf_t stopped_by; /* who stopped the run, a JSON string; empty: nobody did */
+    struct canbus_client *control; /* the launcher's control channel, or NULL */
     bool trace_error;
 } canbus_bus_t;
 

@@ -71,6 +71,9 @@ void canbus__handle_records(canbus_bus_t *b, canbus_client_t *c, const uint8_t *
  * refused, and with which STOP reason. */
 const char *canbus__admit(canbus_bus_t *b, canbus_client_t *c, const struct canbus_hello *h,
                           uint32_t *stop_reason);
+/* PROCESS: the process of `node` (its declared clients: it or its children); false if no
+ * client of that node is declared. */
+bool canbus__declare_process(canbus_bus_t *b, uint32_t node, pid_t pid);
 /* A refused hello, into the statistics' `refused` list. */
 void canbus__note_refused_hello(canbus_bus_t *b, const canbus_client_t *c, const char *why);
 /* A record the client may not send: not acted on, counted by type, rejected. */

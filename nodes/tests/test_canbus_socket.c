@@ -624,9 +624,14 @@ static int scenario_admission(const char *dir)
     char *argv[] = {(char *)bus_path, "--socket", sock, "--lockstep-clients", "1",
                     "--quantum-us", "1000", "--trace", trace, "--stats", stats_path,
                     "--control-fd", ctl_fd, "--client", "n1:can+lockstep:1",
-                    "--client", "n1/io:can:1", "-q", NULL};
+                    "--client", "n1/io:can:1", "--client", "n2/io:can:2", "-q", NULL};
     pid_t pid = start_bus(argv, sock);
     close(ctl[1]);
+    /* Node 1's process is this test (its clients: it or its children); node 2's is the bus
+     * itself, so that this test is nobody of node 2. */
+    struct canbus_rec procs[] = {{.type = CANBUS_MSG_PROCESS, .id = 1, .t_ns = getpid()},
+                                 {.type = CANBUS_MSG_PROCESS, .id = 2, .t_ns = pid}};
+    CHECK(send(ctl[0], procs, sizeof procs, 0) == (ssize_t)sizeof procs);
     client_t n1, io, io2, tool;
     struct canbus_rec got[64], tick;
     int n;
@@ -638,6 +643,7 @@ static int scenario_admission(const char *dir)
     CHECK_EQ(refused_hello(sock, "0123456789abcdef0123456789abcdef", CANBUS_ROLE_CAN, 0),
              CANBUS_STOP_BAD_HELLO);
     CHECK_EQ(refused_hello(sock, "bad\nname", CANBUS_ROLE_CAN, 0), CANBUS_STOP_BAD_HELLO);
+    CHECK_EQ(refused_hello(sock, "n2/io", CANBUS_ROLE_CAN, 2), CANBUS_STOP_REFUSED);
     REQUIRE(join_node(&io, sock, "n1/io", CANBUS_ROLE_CAN, 1) == 0);
     CHECK_EQ(io.wl.flags, 0);
     CHECK_EQ(refused_hello(sock, "n1/io", CANBUS_ROLE_CAN, 1), CANBUS_STOP_REFUSED);
@@ -680,17 +686,18 @@ static int scenario_admission(const char *dir)
     static char text[1 << 16];
     REQUIRE(read_file(stats_path, text, sizeof text) > 0);
     static const char *const stats_has[] = {
-        "\"frames\":1,", "\"bad_hellos\":2,", "\"refused_hellos\":5,",
+        "\"frames\":1,", "\"bad_hellos\":2,", "\"refused_hellos\":6,",
         "\"refused_records\":3,", "\"stopped_by\":\"launcher\"", "\"name\":\"python-can\"",
         "\"listen_only\":true", "refused: not_as_declared\"}", "refused: undeclared_lockstep\"}",
         "refused: unknown_node\"}", "refused: duplicate_name\"}", "listen-only, pid ",
+        "refused: not_its_process\"}",
         "refused 1 FRAME, 1 STOP, 1 FAULT\"}"};
     for (size_t i = 0; i < sizeof stats_has / sizeof *stats_has; i++)
         if (!strstr(text, stats_has[i])) {
             fprintf(stderr, "stats5.json lacks %s\n", stats_has[i]);
             failures++;
         }
-    CHECK_EQ(count(text, "{\"what\":\"can_client\",\"detail\":"), 8);
+    CHECK_EQ(count(text, "{\"what\":\"can_client\",\"detail\":"), 9);
     REQUIRE(read_file(trace, text, sizeof text) > 0);
     CHECK(strstr(text, "\"kind\":\"stop_request\",\"by\":\"launcher\"}"));
     CHECK_EQ(count(text, "\"reason\":\"listen_only\""), 3);

@@ -6,6 +6,7 @@ STOP does not."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import time
 
@@ -39,6 +40,7 @@ def bus(tmp_path):
                                  "--control-fd", str(control.child_fd), "-q"],
                                 pass_fds=(control.child_fd,))
         control.started()
+        control.process(0, os.getpid())  # the world is this test
         started.append((proc, control))
         deadline = time.monotonic() + 10
         while not sock.exists():

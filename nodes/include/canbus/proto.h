@@ -48,9 +48,11 @@
  * A LOCKSTEP client that disconnects leaves the lockstep (a dead node does not stop the others).
  *
  * Control channel (ima-canbus --control-fd N): the launcher's end of a socketpair the bus
- * inherits, never reachable by a path. It carries the same 32-byte records, of two types only:
- * FAULT (arm a bus fault) and STOP (end the run, stopped_by "launcher"). A FAULT record, or a
- * STOP from a client without the LOCKSTEP role, on the public socket is refused and counted.
+ * inherits, never reachable by a path. It carries the same 32-byte records, of three types
+ * only: FAULT (arm a bus fault), STOP (end the run, stopped_by "launcher") and PROCESS (the
+ * process of a node, whose declared clients must be it or its children: without it a
+ * declared client is refused). A FAULT or PROCESS record, or a STOP from a client without the
+ * LOCKSTEP role, on the public socket is refused and counted.
  */
 #ifndef CANBUS_PROTO_H
 #define CANBUS_PROTO_H
@@ -102,6 +104,9 @@ enum canbus_rec_type {
     CANBUS_MSG_ERROR = 5, /* bus -> CAN clients: an error frame on the wire (id = the frame's
                              identifier, t_ns = when, data[0] = sender, data[1] = its state) */
     CANBUS_MSG_FAULT = 6, /* control channel -> bus: arm a bus fault (nodes/README.md) */
+    CANBUS_MSG_PROCESS = 7, /* control channel -> bus: id = a node (0: the world), t_ns = the
+                               pid of its process (a SKE, the world): its declared clients
+                               must be that process or a child of it (its partitions) */
 };
 
 /* ERROR record, in full (bus -> every CAN client, delivered like a frame, in wire order):

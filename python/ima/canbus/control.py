@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The launcher's end of the bus's control channel (ima-canbus --control-fd): a socketpair whose
-other end the bus inherits, so that nobody else can arm a bus fault or stop the run through it
-(proto.h, "Control channel")."""
+other end the bus inherits, so that nobody else can arm a bus fault, stop the run or name the
+processes of the declared clients through it (proto.h, "Control channel")."""
 
 from __future__ import annotations
 
@@ -36,6 +36,11 @@ class BusControl:
     def stop(self) -> bool:
         """Ends the run (the statistics' stopped_by is "launcher"); False if the bus is gone."""
         return self._send(proto.pack_rec(proto.MSG_STOP, proto.STOP_REQUESTED))
+
+    def process(self, node: int, pid: int) -> bool:
+        """Names the process of a node (0: the world): the bus admits a client declared for
+        that node only from that process or a child of it (a SKE's partitions)."""
+        return self._send(proto.pack_rec(proto.MSG_PROCESS, node, pid))
 
     def arm(self, fault_rec: bytes) -> bool:
         """Arms a bus fault: one FAULT record as proto.h lays it out."""

@@ -169,12 +169,15 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
             if netns is not None:
                 cmd = netns.wrap(node, cmd)
             proc = ps.start(node, cmd, cwd=sock_dir)
+            # its clients on the bus: the SKE and its partitions
+            control.process(next(n.index for n in system.nodes if n.name == node), proc.pid)
             if f"{node}/dds" in ske_pipes:
                 _tell_ske(open_fds, ske_pipes[f"{node}/dds"][1], proc.pid)
             if netns is not None:
                 netns_pids.append(proc.pid)
             procs.wait_joined(procs_plan.bus_socket, k, ps, pids=tuple(netns_pids))
         world = ps.start("world", procs_plan.world, stdout=subprocess.PIPE)
+        control.process(0, world.pid)
         watch = procs.Watch(ps, kills, control.stop)
         threading.Thread(target=watch, daemon=True).start()
         procs.follow_world(world, _watching(on_status, stop_when, control))

@@ -213,6 +213,8 @@ static void reap(canbus_bus_t *b)
         if (!c->gone)
             b->live[k++] = c;
         else if (c->index < 0) {
+            if (c == b->control)
+                b->control = NULL; /* the launcher has gone: no more PROCESS records */
             canbus__trace_write(b, &c->staged);
             canbus_sb_free(&c->staged);
             canbus_sb_free(&c->jname);

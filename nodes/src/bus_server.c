@@ -5,7 +5,6 @@
 
 #include <errno.h>
 #include <inttypes.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
@@ -14,29 +13,6 @@
 #include <unistd.h>
 
 volatile sig_atomic_t canbus_signalled;
-
-/* Binds and listens at sa's path, 0600: only the run's owner may connect (who does is checked
- * again at accept). The socket is made under a temporary name beside it and renamed into
- * place once it listens, so that whoever sees the path (the launcher waits for it) can
- * connect at once: a connect between bind() and listen() would be refused. */
-static int bind_listen(int fd, const struct sockaddr_un *sa)
-{
-    struct sockaddr_un tmp = {.sun_family = AF_UNIX};
-    int n = snprintf(tmp.sun_path, sizeof tmp.sun_path, "%s.%ld", sa->sun_path, (long)getpid());
-    bool renamed = n > 0 && (size_t)n < sizeof tmp.sun_path;
-    const struct sockaddr_un *at = renamed ? &tmp : sa; /* too long a path: bound in place */
-    if (renamed)
-        unlink(tmp.sun_path); /* left by a bus of the same pid that died here */
-    if (bind(fd, (const struct sockaddr *)at, sizeof *at))
-        return -errno;
-    if (chmod(at->sun_path, S_IRUSR | S_IWUSR) || listen(fd, 128) ||
-        (renamed && rename(tmp.sun_path, sa->sun_path))) {
-        int rc = -errno;
-        unlink(at->sun_path); /* ours: bound above */
-        return rc;
-    }
-    return 0;
-}
 
 int canbus_bus_open(canbus_bus_t *b, const canbus_opts_t *o)
 {
@@ -89,8 +65,12 @@ int canbus_bus_open(canbus_bus_t *b, const canbus_opts_t *o)
             close(probe);
         unlink(o->socket_path);
     }
-    if ((rc = bind_listen(b->listen_fd, &sa)))
+    /* 0600: only the run's owner may connect (who does is checked again at accept) */
+    if (bind(b->listen_fd, (struct sockaddr *)&sa, sizeof sa) ||
+        chmod(o->socket_path, S_IRUSR | S_IWUSR) || listen(b->listen_fd, 128)) {
+        rc = -errno;
         goto fail_sock;
+    }
     if (o->control_fd >= 0 && (rc = canbus__control_open(b))) {
         unlink(o->socket_path);
         goto fail_sock;

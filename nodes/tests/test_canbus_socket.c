@@ -47,10 +47,17 @@ static pid_t start_bus(char *const argv[], const char *sock)
         perror("execv");
         _exit(127);
     }
-    /* Wait for the socket to appear. */
+    /* Wait until the bus listens: its socket appears at bind(), a moment before listen(), and
+     * a connect in between is refused (a slow bus, under ASan on a loaded host, shows it). The
+     * probe's connection closes before any hello: the bus forgets it without a trace line. */
+    struct sockaddr_un sa = {.sun_family = AF_UNIX};
+    snprintf(sa.sun_path, sizeof sa.sun_path, "%s", sock);
     for (int i = 0; i < 500; i++) {
-        struct stat st;
-        if (stat(sock, &st) == 0)
+        int fd = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+        int rc = fd >= 0 ? connect(fd, (struct sockaddr *)&sa, sizeof sa) : -1;
+        if (fd >= 0)
+            close(fd);
+        if (rc == 0)
             return pid;
         struct timespec ts = {0, 10000000};
         nanosleep(&ts, NULL);

@@ -108,7 +108,7 @@ typedef struct {
     int topic;
 } agent_rd_ctx_t;
 
-/* An entry of the statistics' `refused` list: what was refused ("io_client", ...), and how. */
+/* An entry of the statistics' `refusals` list: what was refused ("io_client", ...), and how. */
 typedef struct {
     char what[24];
     char detail[200];
@@ -149,7 +149,7 @@ struct agent {
     pid_t ske_pid;             /* --ske-pid-fd: the node's SKE; 0 not known yet, -1 none */
     agent_refused_t refused[AGENT_REFUSED_MAX];
     unsigned n_refused;
-    uint64_t refused_unlisted;
+    uint64_t refusals_unlisted;
     bool own_instance;         /* our CrossChannelInputs instance is registered (not disposed) */
 
     /* the exchange */
@@ -219,7 +219,7 @@ void agent_guard_read_ske(agent_t *a);
 /* Whether the peer of a connection to the io socket may be io; a refusal is counted, traced
  * and listed. */
 bool agent_guard_may_be_io(agent_t *a, int fd);
-/* An entry of the statistics' `refused` list (what: "io_client", ...). */
+/* An entry of the statistics' `refusals` list (what: "io_client", ...). */
 void agent_refused_add(agent_t *a, const char *what, const char *detail);
 
 /* agent_fault.c */

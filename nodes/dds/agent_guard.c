@@ -4,7 +4,7 @@
  * children: the SKE forks every partition itself, restarted ones too. The launcher writes the
  * SKE's pid into an inherited pipe once it has started it (the agent starts first); until
  * then no connection is taken. Refusals are counted, traced and listed in the statistics'
- * `refused` list, which other parts of the agent may add to (agent_refused_add). */
+ * `refusals` list, which other parts of the agent may add to (agent_refused_add). */
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -19,7 +19,7 @@
 void agent_refused_add(agent_t *a, const char *what, const char *detail)
 {
     if (a->n_refused >= AGENT_REFUSED_MAX) {
-        a->refused_unlisted++;
+        a->refusals_unlisted++;
         return;
     }
     agent_refused_t *r = &a->refused[a->n_refused++];

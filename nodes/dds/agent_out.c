@@ -208,8 +208,8 @@ int agent_write_stats(agent_t *a)
                 p->deadline_misses);
         first = false;
     }
-    fprintf(f, "],\"io_refused\":%" PRIu64 ",\"refused_unlisted\":%" PRIu64 ",\"refused\":[",
-            a->io_refused, a->refused_unlisted);
+    fprintf(f, "],\"io_refused\":%" PRIu64 ",\"refusals_unlisted\":%" PRIu64 ",\"refusals\":[",
+            a->io_refused, a->refusals_unlisted);
     for (unsigned i = 0; i < a->n_refused; i++) {
         fprintf(f, "%s{\"what\":", i ? "," : "");
         write_json_str(f, a->refused[i].what);

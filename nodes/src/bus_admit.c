@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Who may join the bus and what a client may send: hellos checked against the clients the
  * launcher declared (--client), undeclared clients admitted listen-only, records a client may
- * not send refused, and the statistics' `refused` list that names them all. A process of the
+ * not send refused, and the statistics' `refusals` list that names them all. A process of the
  * run's own user reaches the public socket (the python-can tools do): it can listen, not act. */
 #include "canbus__server.h"
 

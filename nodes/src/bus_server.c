@@ -146,7 +146,7 @@ int canbus_bus_write_stats(canbus_bus_t *b, const char *path)
         canbus_sb_mem(s, b->stopped_by.p, b->stopped_by.n);
     else
         canbus_sb_str(s, "null");
-    canbus_sb_str(s, ",\"refused\":");
+    canbus_sb_str(s, ",\"refusals\":");
     canbus__sb_refused(b, s);
     canbus_sb_str(s, "}\n");
     int rc = s->oom ? -ENOMEM : 0;

@@ -137,7 +137,7 @@ typedef struct canbus_bus {
     uint64_t faults_armed;
     uint64_t refused_users; /* connections of another user, closed at once */
     uint64_t refused_hellos, refused_records; /* by the admission policy (bus_admit.c) */
-    canbus_sbuf_t refused;  /* the statistics' `refused` entries of refused hellos */
+    canbus_sbuf_t refused;  /* the statistics' `refusals` entries of refused hellos */
     size_t n_refused;
     canbus_sbuf_t stopped_by; /* who stopped the run, a JSON string; empty: nobody did */
     struct canbus_client *control; /* the launcher's control channel, or NULL */

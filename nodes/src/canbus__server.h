@@ -74,11 +74,11 @@ const char *canbus__admit(canbus_bus_t *b, canbus_client_t *c, const struct canb
 /* PROCESS: the process of `node` (its declared clients: it or its children); false if no
  * client of that node is declared. */
 bool canbus__declare_process(canbus_bus_t *b, uint32_t node, pid_t pid);
-/* A refused hello, into the statistics' `refused` list. */
+/* A refused hello, into the statistics' `refusals` list. */
 void canbus__note_refused_hello(canbus_bus_t *b, const canbus_client_t *c, const char *why);
 /* A record the client may not send: not acted on, counted by type, rejected. */
 void canbus__refuse_record(canbus_bus_t *b, canbus_client_t *c, uint8_t type, const char *why);
-/* The statistics' `refused` array: refused hellos, then every client that sent records it
+/* The statistics' `refusals` array: refused hellos, then every client that sent records it
  * may not. */
 void canbus__sb_refused(canbus_bus_t *b, canbus_sbuf_t *s);
 

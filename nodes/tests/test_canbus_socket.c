@@ -734,7 +734,7 @@ static int scenario_signal(const char *dir)
     CHECK_EQ(wait_bus(pid), 0);
     static char text[1 << 16];
     CHECK(read_file(stats_path, text, sizeof text) > 0 && strstr(text, "\"stop\":\"signal\""));
-    CHECK(strstr(text, "\"stopped_by\":\"signal\",\"refused\":[]}"));
+    CHECK(strstr(text, "\"stopped_by\":\"signal\",\"refusals\":[]}"));
     return 0;
 }
 

@@ -77,9 +77,9 @@ def test_the_launcher_stops_the_run_on_its_channel(bus):
     assert proc.wait(timeout=10) == 0
     st = _stats(stats)
     assert st["stopped_by"] == "launcher" and st["refused_records"] == 1
-    assert [e["what"] for e in st["refused"]] == ["can_client"]
-    assert st["refused"][0]["detail"].startswith("'logger' (client 1, listen-only, pid ")
-    assert st["refused"][0]["detail"].endswith("refused 1 STOP")
+    assert [e["what"] for e in st["refusals"]] == ["can_client"]
+    assert st["refusals"][0]["detail"].startswith("'logger' (client 1, listen-only, pid ")
+    assert st["refusals"][0]["detail"].endswith("refused 1 STOP")
     assert not control.stop()  # the bus has gone
 
 

@@ -69,7 +69,7 @@ def test_only_a_child_of_the_ske_may_be_io(run_dir, domain):
             os.close(fd)
     st = agent.read_stats()
     assert st["io_refused"] == 2 and st["io_connections"] == 2, st
-    assert [e["what"] for e in st["refused"]] == ["io_client", "io_client"]
-    assert "is not a partition of node1's SKE" in st["refused"][0]["detail"]
+    assert [e["what"] for e in st["refusals"]] == ["io_client", "io_client"]
+    assert "is not a partition of node1's SKE" in st["refusals"][0]["detail"]
     assert len(agent.of_kind("io_refused_process")) == 2
     assert agent.of_kind("io_ske", ske_pid=os.getpid())

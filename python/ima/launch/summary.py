@@ -66,14 +66,14 @@ def _stats(path: Path) -> dict | None:
 
 
 def refused(run_dir: Path, nodes: list[str]) -> list[dict]:
-    """What the run's processes refused, one list from the `refused` list of every statistics
+    """What the run's processes refused, one list from the `refusals` list of every statistics
     file that has one: the bus's (`can_client`), each DDS agent's (`io_client`, ...); each
     entry {"what", "detail"} with `by`, the process that refused it (docs/flight.md)."""
     sources = [("canbus", run_dir / "canbus.json")]
     sources += [(f"{node}/dds", run_dir / f"dds{k}.json") for k, node in enumerate(nodes, 1)]
     out = []
     for by, path in sources:
-        for entry in (_stats(path) or {}).get("refused") or []:
+        for entry in (_stats(path) or {}).get("refusals") or []:
             if isinstance(entry, dict) and isinstance(entry.get("what"), str):
                 out.append({"what": entry["what"], "detail": str(entry.get("detail", "")),
                             "by": by})

@@ -20,7 +20,7 @@ static void usage(FILE *f)
           "                    [--realtime] [--xch-timeout-us 2000] [--lease-ms 1000]\n"
           "                    [--deadline-ms 150] [--startup-timeout-ms 20000]\n"
           "                    [--bind-device lo] [--trace FILE] [--stats FILE]\n"
-          "                    [--security DIR] [--fault SPEC]... [-q]\n"
+          "                    [--security DIR] [--fault SPEC]... [--ske-pid-fd FD] [-q]\n"
           "  --config FILE  Cyclone DDS configuration (default: $IMA_DDS_CONFIG; the shipped\n"
           "                 one is config/dds/cyclonedds-loopback.xml)\n"
           "  --bind-device  interface every DDS socket is bound to (\"\" leaves them as\n"
@@ -30,7 +30,9 @@ static void usage(FILE *f)
           "                 permissions.p7s; without it the agent runs without security\n"
           "  --fault SPEC   dds_drop:fid=ID,at=TIME[,until=TIME][,period=TIME,on=TIME] or\n"
           "                 dds_delay:...,frames=N: this node's inputs and health are not\n"
-          "                 published, or published N major frames late (faultinject/README.md)\n",
+          "                 published, or published N major frames late (faultinject/README.md)\n"
+          "  --ske-pid-fd FD  an inherited pipe where the launcher writes the node's SKE pid:\n"
+          "                 only a partition process of that SKE may then be io\n",
           f);
 }
 
@@ -48,6 +50,7 @@ static bool parse_i64(const char *s, int64_t lo, int64_t hi, int64_t *out)
 enum {
     OPT_NODE = 256, OPT_NODES, OPT_SOCKET, OPT_DOMAIN, OPT_CONFIG, OPT_REALTIME, OPT_XCH_TIMEOUT,
     OPT_LEASE, OPT_DEADLINE, OPT_STARTUP, OPT_BIND, OPT_TRACE, OPT_STATS, OPT_FAULT, OPT_SECURITY,
+    OPT_SKE,
     OPT_HELP,
 };
 
@@ -69,6 +72,7 @@ static int parse_args(int argc, char **argv, agent_opts_t *o, dds_faults_t *faul
         {"stats", required_argument, NULL, OPT_STATS},
         {"fault", required_argument, NULL, OPT_FAULT},
         {"security", required_argument, NULL, OPT_SECURITY},
+        {"ske-pid-fd", required_argument, NULL, OPT_SKE},
         {"help", no_argument, NULL, OPT_HELP},
         {NULL, 0, NULL, 0},
     };
@@ -77,7 +81,8 @@ static int parse_args(int argc, char **argv, agent_opts_t *o, dds_faults_t *faul
                         .lease_ns = 1000 * 1000000LL,
                         .deadline_ns = 150 * 1000000LL,
                         .startup_timeout_ns = 20000 * 1000000LL,
-                        .bind_device = "lo"};
+                        .bind_device = "lo",
+                        .ske_pid_fd = -1};
     int c;
     char why[200];
     opterr = 0;
@@ -143,6 +148,15 @@ static int parse_args(int argc, char **argv, agent_opts_t *o, dds_faults_t *faul
         case OPT_FAULT:
             if (dds_fault_add(faults, optarg, why, sizeof why) != 0)
                 bad = why;
+            break;
+        case OPT_SKE:
+            if (!parse_i64(optarg, 3, 1 << 20, &v) || fcntl((int)v, F_GETFD) < 0)
+                bad = "--ske-pid-fd wants an open descriptor >= 3";
+            else {
+                o->ske_pid_fd = (int)v;
+                fcntl(o->ske_pid_fd, F_SETFD, FD_CLOEXEC);
+                fcntl(o->ske_pid_fd, F_SETFL, O_NONBLOCK);
+            }
             break;
         case 'q':
             o->quiet = true;
@@ -317,9 +331,15 @@ static void discover(agent_t *a)
 static void run(agent_t *a)
 {
     while (!a->stop) {
-        struct pollfd p[3] = {{.fd = a->sig_fd, .events = POLLIN},
-                              {.fd = a->wake_rd, .events = POLLIN},
-                              {.fd = a->io_fd >= 0 ? a->io_fd : a->listen_fd, .events = POLLIN}};
+        /* Connections are taken once the SKE is known (--ske-pid-fd), and while nobody waits
+         * to follow io; a negative descriptor is not polled. */
+        bool ske_known = a->o.ske_pid_fd < 0;
+        struct pollfd p[5] = {
+            {.fd = a->sig_fd, .events = POLLIN},
+            {.fd = a->wake_rd, .events = POLLIN},
+            {.fd = a->io_fd, .events = POLLIN},
+            {.fd = ske_known && a->io_next_fd < 0 ? a->listen_fd : -1, .events = POLLIN},
+            {.fd = a->o.ske_pid_fd, .events = POLLIN}};
         struct timespec ts, *tsp = NULL;
         if (a->pending && a->o.realtime) {
             ts = ts_of(a->pend_start_ns + a->o.xch_timeout_ns - agent_mono_ns());
@@ -329,7 +349,7 @@ static void run(agent_t *a)
             tsp = &ts;
         }
         pthread_mutex_unlock(&a->state);
-        int n = ppoll(p, 3, tsp, NULL);
+        int n = ppoll(p, 5, tsp, NULL);
         pthread_mutex_lock(&a->state);
         if (n < 0 && errno != EINTR)
             break;
@@ -345,12 +365,12 @@ static void run(agent_t *a)
             drain_wake(a);
             agent_io_catch_up(a);
         }
-        if (p[2].revents) {
-            if (a->io_fd >= 0)
-                agent_io_readable(a);
-            else
-                agent_io_accept(a);
-        }
+        if (p[2].revents && a->io_fd >= 0)
+            agent_io_readable(a);
+        if (p[3].revents)
+            agent_io_accept(a);
+        if (p[4].revents)
+            agent_guard_read_ske(a);
     }
 }
 
@@ -371,7 +391,7 @@ int main(int argc, char **argv)
     static agent_t agent;
     hold_std_fds();
     agent_t *a = &agent;
-    a->listen_fd = a->io_fd = a->sig_fd = a->wake_rd = a->wake_wr = -1;
+    a->listen_fd = a->io_fd = a->io_next_fd = a->sig_fd = a->wake_rd = a->wake_wr = -1;
     if (parse_args(argc, argv, &a->o, &a->faults) != 0)
         return 2;
     snprintf(a->node_name, sizeof a->node_name, "node%u", a->o.node);

@@ -40,6 +40,7 @@ typedef struct {
     const char *security_dir;  /* the run's DDS Security files (NULL: no security) */
     const char *trace_path, *stats_path;
     bool quiet;
+    int ske_pid_fd;            /* --ske-pid-fd: where the launcher writes the SKE's pid, or -1 */
 } agent_opts_t;
 
 /* What a Cyclone listener tells the main thread. */
@@ -125,6 +126,14 @@ typedef struct {
     int topic;
 } agent_rd_ctx_t;
 
+/* An entry of the statistics' `refusals` list: what was refused ("io_client", ...), and how. */
+typedef struct {
+    char what[24];
+    char detail[200];
+} agent_refused_t;
+
+#define AGENT_REFUSED_MAX 32 /* listed; later ones only counted */
+
 struct agent {
     agent_opts_t o;
     char node_name[16];
@@ -155,8 +164,13 @@ struct agent {
 
     /* io link */
     int listen_fd, io_fd;
+    int io_next_fd;            /* a partition of the SKE that connected while io_fd was up */
     bool io_hello;             /* HELLO received on io_fd */
-    uint64_t io_connections, io_disconnects;
+    uint64_t io_connections, io_disconnects, io_refused;
+    pid_t ske_pid;             /* --ske-pid-fd: the node's SKE; 0 not known yet, -1 none */
+    agent_refused_t refused[AGENT_REFUSED_MAX];
+    unsigned n_refused;
+    uint64_t refusals_unlisted;
     bool own_instance;         /* our CrossChannelInputs instance is registered (not disposed) */
 
     /* the exchange */
@@ -243,6 +257,15 @@ void agent_io_check_pending(agent_t *a, bool timed_out);
 /* The listeners' queued events, the samples that came in, then the pending request. */
 void agent_io_catch_up(agent_t *a);
 void agent_io_shutdown(agent_t *a);
+
+/* agent_guard.c: who may be io */
+/* Reads the SKE's pid the launcher wrote to --ske-pid-fd (the descriptor is then closed). */
+void agent_guard_read_ske(agent_t *a);
+/* Whether the peer of a connection to the io socket may be io; a refusal is counted, traced
+ * and listed. */
+bool agent_guard_may_be_io(agent_t *a, int fd);
+/* An entry of the statistics' `refusals` list (what: "io_client", ...). */
+void agent_refused_add(agent_t *a, const char *what, const char *detail);
 
 /* agent_fault.c */
 /* Publishes one of io's INPUTS or HEALTH as this node's faults have it: now, late, or not (in

@@ -59,22 +59,37 @@ int agent_io_listen(agent_t *a)
     return 0;
 }
 
+static void take_io(agent_t *a, int fd)
+{
+    a->io_fd = fd;
+    a->io_hello = false;
+    a->io_connections++;
+    agent_trace_simple(a, "io_connect");
+}
+
+/* Every connection is taken at once and checked (agent_guard.c): one that may not be io is
+ * closed whether or not io's link is up. One that may, while the link is up, is io restarted
+ * by its SKE: the old link is read to its end first (its process is gone, its last datagrams
+ * are not), and the newcomer waits in io_next_fd if the old one is still open. */
 void agent_io_accept(agent_t *a)
 {
     int fd = accept4(a->listen_fd, NULL, NULL, SOCK_CLOEXEC | SOCK_NONBLOCK);
     if (fd < 0)
         return; /* EAGAIN, or the peer gave up already */
-    struct ucred cred;
-    socklen_t len = sizeof cred;
-    if (getsockopt(fd, SOL_SOCKET, SO_PEERCRED, &cred, &len) != 0 || cred.uid != getuid()) {
-        close(fd); /* only the run's owner's io may use its agent */
-        agent_trace_simple(a, "io_refused_user");
+    if (!agent_guard_may_be_io(a, fd)) {
+        close(fd);
         return;
     }
-    a->io_fd = fd;
-    a->io_hello = false;
-    a->io_connections++;
-    agent_trace_simple(a, "io_connect");
+    if (a->io_fd >= 0)
+        agent_io_readable(a);
+    if (a->io_fd < 0)
+        take_io(a, fd);
+    else if (a->io_next_fd < 0)
+        a->io_next_fd = fd;
+    else {
+        close(a->io_next_fd); /* the later of two waiting partitions is the live one */
+        a->io_next_fd = fd;
+    }
 }
 
 void agent_io_close(agent_t *a, const char *reason)
@@ -92,6 +107,10 @@ void agent_io_close(agent_t *a, const char *reason)
     }
     agent_log(a, "io link closed (%s); waiting for a new connection", reason);
     agent_dds_withdraw(a);
+    if (a->io_next_fd >= 0) {
+        take_io(a, a->io_next_fd);
+        a->io_next_fd = -1;
+    }
     /* Closed by the inputs listener, the main thread may be polling the old descriptor. */
     agent_wake(a);
 }
@@ -101,6 +120,9 @@ void agent_io_shutdown(agent_t *a)
     if (a->io_fd >= 0)
         close(a->io_fd);
     a->io_fd = -1;
+    if (a->io_next_fd >= 0)
+        close(a->io_next_fd);
+    a->io_next_fd = -1;
     if (a->listen_fd >= 0) {
         close(a->listen_fd);
         unlink(a->o.socket_path);

@@ -135,6 +135,22 @@ static void write_lat(FILE *f, const char *key, const agent_lat_t *l)
     free(sorted);
 }
 
+/* A JSON string literal: the refused list's texts hold process names, which may hold anything. */
+static void write_json_str(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(f, "\\%c", c);
+        else if (c < 0x20 || c >= 0x7F)
+            fprintf(f, "\\u%04x", c);
+        else
+            fputc(c, f);
+    }
+    fputc('"', f);
+}
+
 static void write_guid(FILE *f, const dds_guid_t *g)
 {
     for (size_t b = 0; b < sizeof g->v; b++)
@@ -224,6 +240,15 @@ int agent_write_stats(agent_t *a)
                 p->alive ? "true" : "false", p->dead ? "true" : "false", p->lost_wall_ns,
                 p->deadline_misses);
         first = false;
+    }
+    fprintf(f, "],\"io_refused\":%" PRIu64 ",\"refusals_unlisted\":%" PRIu64 ",\"refusals\":[",
+            a->io_refused, a->refusals_unlisted);
+    for (unsigned i = 0; i < a->n_refused; i++) {
+        fprintf(f, "%s{\"what\":", i ? "," : "");
+        write_json_str(f, a->refused[i].what);
+        fputs(",\"detail\":", f);
+        write_json_str(f, a->refused[i].detail);
+        fputc('}', f);
     }
     fputs("]}\n", f);
     if (fclose(f) != 0) {

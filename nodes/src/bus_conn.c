@@ -127,7 +127,7 @@ void canbus__send_stop(canbus_bus_t *b, canbus_client_t *c, uint32_t reason)
 
 /* Reads what the client has queued, up to a bound so that a flooding client cannot keep
  * the bus in here (well-behaved clients send far fewer datagrams per quantum). */
-static void read_client(canbus_bus_t *b, canbus_client_t *c)
+void canbus__read_client(canbus_bus_t *b, canbus_client_t *c)
 {
     for (int k = 0; k < 1024 && !c->gone; k++) {
         struct iovec iov = {.iov_base = b->rxbuf, .iov_len = RXBUF_SIZE};
@@ -143,6 +143,10 @@ static void read_client(canbus_bus_t *b, canbus_client_t *c)
         if (n == 0) {
             canbus__client_leave(b, c, "closed");
             return;
+        }
+        if (c->control) { /* a truncated datagram is rejected for its size (1 byte) */
+            canbus__handle_control(b, c, b->rxbuf, (m.msg_flags & MSG_TRUNC) ? 1 : (size_t)n);
+            continue;
         }
         if (c->index < 0) {
             canbus__handle_hello(b, c, b->rxbuf, (m.msg_flags & MSG_TRUNC) ? 0 : (size_t)n);
@@ -209,6 +213,8 @@ static void reap(canbus_bus_t *b)
         if (!c->gone)
             b->live[k++] = c;
         else if (c->index < 0) {
+            if (c == b->control)
+                b->control = NULL; /* the launcher has gone: no more PROCESS records */
             canbus__trace_write(b, &c->staged);
             canbus_sb_free(&c->staged);
             canbus_sb_free(&c->jname);
@@ -254,7 +260,7 @@ void canbus__service(canbus_bus_t *b, int64_t timeout_ns)
             if (fds[i].revents & POLLOUT)
                 canbus__flush_queue(b, c);
             if (fds[i].revents & (POLLIN | POLLHUP | POLLERR))
-                read_client(b, c);
+                canbus__read_client(b, c);
         }
     }
     int64_t now = canbus__wall_ns();
@@ -278,6 +284,6 @@ void canbus__read_all(canbus_bus_t *b)
     accept_all(b);
     for (size_t i = 0; i < b->n_live; i++)
         if (!b->live[i]->gone)
-            read_client(b, b->live[i]);
+            canbus__read_client(b, b->live[i]);
     reap(b);
 }

@@ -26,8 +26,10 @@ static void usage(FILE *f)
           "  --max-clients N          connected clients at most (64)\n"
           "  --fault SPEC             CLASS:fid=ID,at=TIME[,until=TIME][,period=TIME,on=TIME][,KEY=VALUE]\n"
           "                           (faultinject/README.md; older KIND:KEY=VALUE too); repeatable\n"
-"  --fault-records          accept FAULT records from clients (tests of the record form; off:\n"
-          "                           a client of the public socket cannot arm a fault)\n"
+          "  --control-fd N           the launcher's control channel: an inherited SOCK_SEQPACKET\n"
+          "                           socket whose FAULT records arm faults and STOP ends the run\n"
+          "  --client NAME:ROLES:NODE a client of the run (ROLES: can, lockstep, own joined by +);\n"
+          "                           repeatable. With any, other names join listen-only\n"
 "  --kill-node N@SECONDS    kill every client of node N (hello.node) at that time; repeatable\n"
           "  --hang-node N@SECONDS    freeze them instead (SIGSTOP): a hung processor; repeatable\n"
           "  --client-order A,B,...   client indices by name (deterministic for racy joins)\n"
@@ -68,12 +70,47 @@ static int parse_i64_n(const char *s, size_t n, int64_t lo, int64_t hi, int64_t 
     return parse_i64(buf, lo, hi, out);
 }
 
+/* --client NAME:ROLES:NODE, ROLES one or more of can, lockstep, own joined by '+'. */
+static int parse_decl(const char *text, canbus_decl_t *d)
+{
+    memset(d, 0, sizeof *d);
+    const char *c1 = strchr(text, ':'), *c2 = c1 ? strchr(c1 + 1, ':') : NULL;
+    if (!c1 || !c2 || c1 == text || (size_t)(c1 - text) >= CANBUS_NAME_LEN)
+        return -1;
+    memcpy(d->name, text, (size_t)(c1 - text));
+    for (const char *p = c1 + 1; p < c2;) {
+        size_t n = strcspn(p, "+:");
+        if (n == 3 && strncmp(p, "can", 3) == 0)
+            d->roles |= CANBUS_ROLE_CAN;
+        else if (n == 8 && strncmp(p, "lockstep", 8) == 0)
+            d->roles |= CANBUS_ROLE_LOCKSTEP;
+        else if (n == 3 && strncmp(p, "own", 3) == 0)
+            d->roles |= CANBUS_ROLE_OWN;
+        else
+            return -1;
+        p += n + (p[n] == '+');
+    }
+    int64_t node;
+    if (!d->roles || parse_i64(c2 + 1, 0, UINT32_MAX, &node))
+        return -1;
+    d->node = (uint32_t)node;
+    return 0;
+}
+
+static void free_opts(canbus_opts_t *o)
+{
+    free(o->faults);
+    free(o->kills);
+    free(o->order);
+    free(o->decls);
+}
+
 int main(int argc, char **argv)
 {
     enum {
         O_SOCKET = 256, O_BITRATE, O_QUANTUM, O_LOCKSTEP, O_DURATION, O_END, O_REALTIME,
         O_TRACE, O_STATS, O_MAXCL, O_FAULT, O_RECOVER, O_MAXREJ, O_SENDTO, O_CLBUF, O_GAP, O_KILL,
-        O_HANG, O_ORDER, O_FAULTREC,
+        O_HANG, O_ORDER, O_CONTROL, O_DECL,
         O_HELP
     };
     static const struct option longopts[] = {
@@ -88,7 +125,8 @@ int main(int argc, char **argv)
         {"stats", required_argument, NULL, O_STATS},
         {"max-clients", required_argument, NULL, O_MAXCL},
         {"fault", required_argument, NULL, O_FAULT},
-        {"fault-records", no_argument, NULL, O_FAULTREC},
+        {"control-fd", required_argument, NULL, O_CONTROL},
+        {"client", required_argument, NULL, O_DECL},
         {"kill-node", required_argument, NULL, O_KILL},
         {"hang-node", required_argument, NULL, O_HANG},
         {"client-order", required_argument, NULL, O_ORDER},
@@ -109,6 +147,7 @@ int main(int argc, char **argv)
         .max_rejects = 100,
         .send_timeout_ns = 2000000000,
         .client_buffer = 8u << 20,
+        .control_fd = -1,
     };
     int opt, status = 0;
     int64_t v;
@@ -146,7 +185,24 @@ int main(int argc, char **argv)
                 bad = "--end-ns must be >= 0";
             break;
         case O_REALTIME: o.realtime = true; break;
-        case O_FAULTREC: o.fault_records = true; break;
+        case O_CONTROL:
+            if (parse_i64(optarg, 3, 1 << 20, &v))
+                bad = "--control-fd must be a descriptor number >= 3";
+            o.control_fd = (int)v;
+            break;
+        case O_DECL: {
+            canbus_decl_t *d = realloc(o.decls, (o.n_decls + 1) * sizeof *d);
+            if (!d) {
+                bad = "out of memory";
+                break;
+            }
+            o.decls = d;
+            if (parse_decl(optarg, &o.decls[o.n_decls]))
+                bad = "--client must be NAME:ROLES:NODE, e.g. node1/io:can:1 or world:can+lockstep:0";
+            else
+                o.n_decls++;
+            break;
+        }
         case O_TRACE: o.trace_path = optarg; break;
         case O_STATS: o.stats_path = optarg; break;
         case O_MAXCL:
@@ -247,17 +303,13 @@ int main(int argc, char **argv)
         }
         if (bad) {
             fprintf(stderr, "ima-canbus: %s\n", bad);
-            free(o.faults);
-            free(o.kills);
-            free(o.order);
+            free_opts(&o);
             return EXIT_USAGE;
         }
     }
     if (!o.socket_path || optind != argc) {
         usage(stderr);
-        free(o.faults);
-        free(o.kills);
-        free(o.order);
+        free_opts(&o);
         return EXIT_USAGE;
     }
 
@@ -275,9 +327,7 @@ int main(int argc, char **argv)
 
     canbus_bus_t *b = calloc(1, sizeof *b);
     if (!b) {
-        free(o.faults);
-        free(o.kills);
-        free(o.order);
+        free_opts(&o);
         return 1;
     }
     int rc = canbus_bus_open(b, &o);
@@ -285,9 +335,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "ima-canbus: cannot open the bus on %s: %s\n", o.socket_path,
                 strerror(-rc));
         free(b);
-        free(o.faults);
-        free(o.kills);
-        free(o.order);
+        free_opts(&o);
         return 1;
     }
     rc = canbus_bus_run(b);
@@ -305,8 +353,6 @@ int main(int argc, char **argv)
         status = 1;
     }
     free(b);
-    free(o.faults);
-    free(o.kills);
-    free(o.order);
+    free_opts(&o);
     return status;
 }

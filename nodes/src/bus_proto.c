@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The bus's side of the protocol of proto.h: hellos (welcome or refusal), and the records of
- * welcomed clients (frames, DONE, STOP, FAULT), each checked before it is acted on. */
+ * welcomed clients (frames, DONE, STOP), each checked before it is acted on. Who may join and
+ * send what is bus_admit.c's; faults come only over the launcher's channel (bus_control.c). */
 #include "canbus__server.h"
 
 #include <inttypes.h>
@@ -44,6 +45,7 @@ static void refuse(canbus_bus_t *b, canbus_client_t *c, uint32_t reason, const c
     canbus_sb_str(&b->staged, ",\"reason\":\"");
     canbus_sb_str(&b->staged, why);
     canbus_sb_str(&b->staged, "\"}\n");
+    canbus__note_refused_hello(b, c, why);
     canbus__send_stop(b, c, reason);
     canbus__flush_queue(b, c);
     canbus__client_leave(b, c, why);
@@ -90,6 +92,16 @@ void canbus__handle_hello(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p,
         refuse(b, c, CANBUS_STOP_BAD_HELLO, "bad_hello");
         return;
     }
+    uint32_t stop_reason;
+    const char *why = canbus__admit(b, c, &h, &stop_reason);
+    if (why) {
+        if (stop_reason == CANBUS_STOP_BAD_HELLO)
+            b->bad_hellos++;
+        else
+            b->refused_hellos++;
+        refuse(b, c, stop_reason, why);
+        return;
+    }
     bool lockstep = h.roles & CANBUS_ROLE_LOCKSTEP;
     if (lockstep && b->started && canbus__members_count(b) >= b->o.lockstep_clients) {
         b->late_joins++;
@@ -121,7 +133,8 @@ void canbus__handle_hello(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p,
         .version = CANBUS_VERSION,
         .client = (uint16_t)c->index,
         .bitrate = b->o.bitrate,
-        .flags = b->o.realtime ? CANBUS_WELCOME_REALTIME : 0,
+        .flags = (b->o.realtime ? CANBUS_WELCOME_REALTIME : 0) |
+                 (c->listen_only ? CANBUS_WELCOME_LISTEN_ONLY : 0),
         .quantum_ns = b->o.quantum_ns,
         .t_ns = !b->started ? 0 : c->member_next ? b->t_next : b->t,
         .end_ns = b->o.end_ns,
@@ -152,44 +165,10 @@ void canbus__handle_hello(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p,
     }
     canbus_sb_str(s, "],\"node_id\":");
     canbus_sb_u64(s, c->node);
+    if (c->listen_only)
+        canbus_sb_str(s, ",\"listen_only\":true");
     canbus_sb_str(s, "}\n");
     canbus__info(b, "client %d (%s) joined, roles 0x%x", c->index, c->name, c->roles);
-}
-
-static void handle_fault(canbus_bus_t *b, canbus_client_t *c, const struct canbus_rec *r)
-{
-    canbus_fault_t f;
-    if (!b->o.fault_records) { /* faults come from the launcher's command line, not clients */
-        canbus__reject(b, c, "fault_records_off");
-        return;
-    }
-    if (canbus_fault_from_rec(r, &f)) {
-        canbus__reject(b, c, "bad_fault");
-        return;
-    }
-    /* Faults armed by records are named in the order they came: rec1, rec2, ... */
-    snprintf(f.fid, sizeof f.fid, "rec%" PRIu64, b->faults_armed + 1);
-    if (canbus_wire_add_fault(&b->wire, &f)) {
-        canbus__reject(b, c, "bad_fault");
-        return;
-    }
-    b->faults_armed++;
-    canbus_sbuf_t *s = &c->staged;
-    canbus__line_head(s, b->t, "fault_armed");
-    canbus_sb_str(s, ",\"fid\":");
-    canbus_sb_json_str(s, f.fid, sizeof f.fid);
-    canbus_sb_str(s, ",\"class\":\"");
-    canbus_sb_str(s, canbus_fault_class_name(f.kind));
-    canbus_sb_str(s, "\",\"target\":");
-    canbus_sb_u64(s, f.target);
-    canbus_sb_str(s, ",\"match_id\":");
-    canbus_sb_u64(s, f.match_id);
-    canbus_sb_str(s, ",\"from_ns\":");
-    canbus_sb_i64(s, f.from_ns);
-    canbus_sb_str(s, ",\"until_ns\":");
-    canbus_sb_i64(s, f.until_ns == INT64_MAX ? -1 : f.until_ns);
-    canbus__sb_client(b, s, "by", (uint8_t)c->index);
-    canbus_sb_str(s, "}\n");
 }
 
 void canbus__handle_records(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p, size_t n)
@@ -197,6 +176,10 @@ void canbus__handle_records(canbus_bus_t *b, canbus_client_t *c, const uint8_t *
     for (size_t off = 0; off < n && !c->gone; off += sizeof(struct canbus_rec)) {
         struct canbus_rec r;
         memcpy(&r, p + off, sizeof r);
+        if (c->listen_only) {
+            canbus__refuse_record(b, c, r.type, "listen_only");
+            continue;
+        }
         switch (r.type) {
         case CANBUS_MSG_FRAME: {
             if (!(c->roles & CANBUS_ROLE_CAN)) {
@@ -244,18 +227,16 @@ void canbus__handle_records(canbus_bus_t *b, canbus_client_t *c, const uint8_t *
             }
             c->done = true;
             break;
-        case CANBUS_MSG_STOP:
-            if (!b->stopping) {
-                b->stopping = true;
-                b->stop_reason = CANBUS_STOP_REQUESTED;
-                canbus_sbuf_t *s = &c->staged;
-                canbus__line_head(s, b->t, "stop_request");
-                canbus__sb_client(b, s, "by", (uint8_t)c->index);
-                canbus_sb_str(s, "}\n");
-                canbus__info(b, "client %d (%s) asked to stop", c->index, c->name);
-            }
+        case CANBUS_MSG_STOP: /* the world's after a crash; a tool's is not its to send */
+            if (c->roles & CANBUS_ROLE_LOCKSTEP)
+                canbus__stop_by(b, c);
+            else
+                canbus__refuse_record(b, c, r.type, "control_record");
             break;
-        case CANBUS_MSG_FAULT: handle_fault(b, c, &r); break;
+        case CANBUS_MSG_FAULT: /* only the launcher arms faults and names processes, */
+        case CANBUS_MSG_PROCESS: /* over its own channel */
+            canbus__refuse_record(b, c, r.type, "control_record");
+            break;
         default: canbus__reject(b, c, "type"); break;
         }
     }

@@ -71,6 +71,10 @@ int canbus_bus_open(canbus_bus_t *b, const canbus_opts_t *o)
         rc = -errno;
         goto fail_sock;
     }
+    if (o->control_fd >= 0 && (rc = canbus__control_open(b))) {
+        unlink(o->socket_path);
+        goto fail_sock;
+    }
     return 0;
 
 fail_sock:
@@ -105,13 +109,15 @@ int canbus_bus_write_stats(canbus_bus_t *b, const char *path)
             ",\"duplicated\":%" PRIu64 ",\"rx_dropped\":%" PRIu64 ",\"rejected\":%" PRIu64 ",\"bad_hellos\":%" PRIu64 ",\"late_joins\":%" PRIu64
             ",\"refused_full\":%" PRIu64 ",\"send_timeouts\":%" PRIu64
             ",\"garbage_disconnects\":%" PRIu64 ",\"faults_armed\":%" PRIu64
-            ",\"refused_users\":%" PRIu64
+            ",\"refused_users\":%" PRIu64 ",\"refused_hellos\":%" PRIu64
+            ",\"refused_records\":%" PRIu64
             ",\"wall_s\":%.6f,\"frames_per_wall_s\":%.1f,\"release_late_max_us\":%.1f"
             ",\"quanta_late\":%" PRIu64 ",\"stop\":\"%s\",\"clients\":[",
             b->o.bitrate, b->o.quantum_ns, b->quanta, b->t, w->frames, w->frame_bits,
             w->busy_bits, canbus_wire_bit_ns(w, w->busy_bits), load, max1, w->error_frames,
             w->bus_off_events, w->dropped, w->duplicated, w->rx_dropped, b->rejected, b->bad_hellos, b->late_joins, b->full,
-            b->send_timeouts, b->garbage_kicks, b->faults_armed + b->o.n_faults, b->refused_users, wall,
+            b->send_timeouts, b->garbage_kicks, b->faults_armed + b->o.n_faults, b->refused_users,
+            b->refused_hellos, b->refused_records, wall,
             wall > 0 ? (double)w->frames / wall : 0.0, (double)b->late_max_ns / 1e3, b->quanta_late,
             canbus__stop_name(b->stop_reason));
     for (int i = 0; i < b->next_index; i++) {
@@ -124,16 +130,30 @@ int canbus_bus_write_stats(canbus_bus_t *b, const char *path)
                 ",\"rejected\":%" PRIu64 ",\"clamped\":%" PRIu64 ",\"overflow\":%" PRIu64
                 ",\"tx_ok\":%" PRIu64
                 ",\"tx_errors\":%" PRIu64 ",\"dropped\":%" PRIu64 ",\"bus_off_events\":%" PRIu64
-                ",\"tec\":%u,\"rec\":%u,\"state\":\"%s\",\"left\":%s}",
+                ",\"tec\":%u,\"rec\":%u,\"state\":\"%s\",\"left\":%s,\"listen_only\":%s}",
                 i ? "," : "", i, (int)c->jname.n, c->jname.p, c->roles, c->tx, c->rx,
                 c->rejected, c->clamped, c->overflow, k->tx_ok, k->tx_err, k->dropped,
                 k->bus_off_events,
                 k->tec, k->rec, canbus__state_name(canbus_wire_state(w, (uint8_t)i)),
-                c->gone ? "true" : "false");
+                c->gone ? "true" : "false", c->listen_only ? "true" : "false");
     }
-    fprintf(f, "]}\n");
-    int rc = 0;
-    if (fflush(f) || ferror(f))
+    /* Who ended the run (null: it reached its end), and what the bus refused. */
+    canbus_sbuf_t *s = &b->line;
+    canbus_sb_str(s, "],\"stopped_by\":");
+    if (b->stop_reason == CANBUS_STOP_SIGNAL)
+        canbus_sb_str(s, "\"signal\"");
+    else if (b->stopped_by.n)
+        canbus_sb_mem(s, b->stopped_by.p, b->stopped_by.n);
+    else
+        canbus_sb_str(s, "null");
+    canbus_sb_str(s, ",\"refusals\":");
+    canbus__sb_refused(b, s);
+    canbus_sb_str(s, "}\n");
+    int rc = s->oom ? -ENOMEM : 0;
+    if (!s->oom)
+        fwrite(s->p, 1, s->n, f);
+    s->n = 0;
+    if ((fflush(f) || ferror(f)) && !rc)
         rc = -EIO;
     if (f != stdout && fclose(f) && !rc)
         rc = -EIO;
@@ -174,6 +194,8 @@ void canbus_bus_close(canbus_bus_t *b)
     }
     canbus_sb_free(&b->staged);
     canbus_sb_free(&b->line);
+    canbus_sb_free(&b->refused);
+    canbus_sb_free(&b->stopped_by);
     free(b->out);
     free(b->rxbuf);
     canbus_wire_fini(&b->wire);

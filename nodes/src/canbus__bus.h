@@ -47,6 +47,15 @@ typedef struct canbus_kill {
     bool done;
 } canbus_kill_t;
 
+/* --client NAME:ROLES:NODE: a client the launcher expects. Once any is declared, a hello must
+ * match its declaration (roles and node), and a client of another name joins listen-only. */
+typedef struct canbus_decl {
+    char name[CANBUS_NAME_LEN];
+    uint16_t roles;
+    uint32_t node;
+    pid_t pid; /* its node's process (a PROCESS record on the control channel), 0 not yet */
+} canbus_decl_t;
+
 typedef struct canbus_opts {
     const char *socket_path;
     uint32_t bitrate;
@@ -54,7 +63,7 @@ typedef struct canbus_opts {
     int lockstep_clients;
     int64_t end_ns; /* -1: none */
     bool realtime;
-    bool fault_records; /* --fault-records: clients may arm faults with FAULT records */
+    int control_fd; /* --control-fd: the launcher's channel (FAULT, STOP), -1 for none */
     const char *trace_path;
     const char *stats_path;
     int max_clients;
@@ -73,6 +82,8 @@ typedef struct canbus_opts {
      * io partition) so get the same indices in every run. */
     char **order;
     size_t n_order;
+    canbus_decl_t *decls;
+    size_t n_decls;
 } canbus_opts_t;
 
 typedef struct canbus_client {
@@ -83,6 +94,9 @@ typedef struct canbus_client {
     uint32_t node;
     char name[CANBUS_NAME_LEN + 1];
     canbus_sbuf_t jname; /* the name as a JSON string */
+    bool control;     /* the launcher's control channel, not a client of the socket */
+    bool listen_only; /* undeclared: receives frames, anything it sends is refused */
+    uint64_t refused_types[8]; /* records refused by policy, by record type (0: others) */
     bool member;      /* takes part in the current quantum */
     bool member_next; /* joined as LOCKSTEP after the start: takes part from the next one */
     bool done;        /* sent DONE for the current quantum */
@@ -122,6 +136,11 @@ typedef struct canbus_bus {
     uint64_t quanta, rejected, bad_hellos, late_joins, full, send_timeouts, garbage_kicks;
     uint64_t faults_armed;
     uint64_t refused_users; /* connections of another user, closed at once */
+    uint64_t refused_hellos, refused_records; /* by the admission policy (bus_admit.c) */
+    canbus_sbuf_t refused;  /* the statistics' `refusals` entries of refused hellos */
+    size_t n_refused;
+    canbus_sbuf_t stopped_by; /* who stopped the run, a JSON string; empty: nobody did */
+    struct canbus_client *control; /* the launcher's control channel, or NULL */
     bool trace_error;
 } canbus_bus_t;
 

@@ -50,6 +50,8 @@ void canbus__send_stop(canbus_bus_t *b, canbus_client_t *c, uint32_t reason);
 void canbus__service(canbus_bus_t *b, int64_t timeout_ns);
 /* Accepts and reads everything pending, without waiting. */
 void canbus__read_all(canbus_bus_t *b);
+/* Reads what one client has sent, without waiting. */
+void canbus__read_client(canbus_bus_t *b, canbus_client_t *c);
 
 /* ---- bus_proto.c: protocol handling ----------------------------------------------------- */
 
@@ -62,5 +64,31 @@ void canbus__reject(canbus_bus_t *b, canbus_client_t *c, const char *reason);
 void canbus__handle_hello(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p, size_t n);
 /* A datagram of records from a welcomed client. */
 void canbus__handle_records(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p, size_t n);
+
+/* ---- bus_admit.c: who may join, what a client may send ----------------------------------- */
+
+/* NULL: the hello is admitted (c->listen_only set for an undeclared client); else why it is
+ * refused, and with which STOP reason. */
+const char *canbus__admit(canbus_bus_t *b, canbus_client_t *c, const struct canbus_hello *h,
+                          uint32_t *stop_reason);
+/* PROCESS: the process of `node` (its declared clients: it or its children); false if no
+ * client of that node is declared. */
+bool canbus__declare_process(canbus_bus_t *b, uint32_t node, pid_t pid);
+/* A refused hello, into the statistics' `refusals` list. */
+void canbus__note_refused_hello(canbus_bus_t *b, const canbus_client_t *c, const char *why);
+/* A record the client may not send: not acted on, counted by type, rejected. */
+void canbus__refuse_record(canbus_bus_t *b, canbus_client_t *c, uint8_t type, const char *why);
+/* The statistics' `refusals` array: refused hellos, then every client that sent records it
+ * may not. */
+void canbus__sb_refused(canbus_bus_t *b, canbus_sbuf_t *s);
+
+/* ---- bus_control.c: the launcher's control channel ------------------------------------ */
+
+/* Takes --control-fd into the live list; a negative errno if it is not a SEQPACKET socket. */
+int canbus__control_open(canbus_bus_t *b);
+/* A datagram on the control channel: STOP and FAULT records. */
+void canbus__handle_control(canbus_bus_t *b, canbus_client_t *c, const uint8_t *p, size_t n);
+/* Ends the run at the request of c (a LOCKSTEP client or the launcher). */
+void canbus__stop_by(canbus_bus_t *b, canbus_client_t *c);
 
 #endif /* CANBUS__SERVER_H */

@@ -4,6 +4,7 @@
 #include "canbus/proto.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <inttypes.h>
 #include <signal.h>
 #include <stdio.h>
@@ -46,10 +47,17 @@ static pid_t start_bus(char *const argv[], const char *sock)
         perror("execv");
         _exit(127);
     }
-    /* Wait for the socket to appear. */
+    /* Wait until the bus listens: its socket appears at bind(), a moment before listen(), and
+     * a connect in between is refused (a slow bus, under ASan on a loaded host, shows it). The
+     * probe's connection closes before any hello: the bus forgets it without a trace line. */
+    struct sockaddr_un sa = {.sun_family = AF_UNIX};
+    snprintf(sa.sun_path, sizeof sa.sun_path, "%s", sock);
     for (int i = 0; i < 500; i++) {
-        struct stat st;
-        if (stat(sock, &st) == 0)
+        int fd = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+        int rc = fd >= 0 ? connect(fd, (struct sockaddr *)&sa, sizeof sa) : -1;
+        if (fd >= 0)
+            close(fd);
+        if (rc == 0)
             return pid;
         struct timespec ts = {0, 10000000};
         nanosleep(&ts, NULL);
@@ -73,18 +81,53 @@ static int raw_connect(const char *sock)
     return fd;
 }
 
-static int join(client_t *c, const char *sock, const char *name, uint16_t roles)
+/* A control channel as the launcher makes it: ctl[0] ours, ctl[1] inherited by the bus (its
+ * number in fd_text, for --control-fd; the caller closes ctl[1] once the bus has started). */
+static int control_pair(int ctl[2], char *fd_text, size_t len)
+{
+    REQUIRE(socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, ctl) == 0);
+    REQUIRE(fcntl(ctl[1], F_SETFD, 0) == 0);
+    snprintf(fd_text, len, "%d", ctl[1]);
+    return 0;
+}
+
+static int join_node(client_t *c, const char *sock, const char *name, uint16_t roles,
+                     uint32_t node)
 {
     memset(c, 0, sizeof *c);
     c->fd = raw_connect(sock);
     REQUIRE(c->fd >= 0);
-    struct canbus_hello h = {.magic = CANBUS_MAGIC, .version = CANBUS_VERSION, .roles = roles};
+    struct canbus_hello h = {.magic = CANBUS_MAGIC, .version = CANBUS_VERSION, .roles = roles,
+                             .node = node};
     snprintf(h.name, sizeof h.name, "%s", name);
     REQUIRE(send(c->fd, &h, sizeof h, 0) == (ssize_t)sizeof h);
     REQUIRE(recv(c->fd, &c->wl, sizeof c->wl, 0) == (ssize_t)sizeof c->wl);
     REQUIRE(c->wl.magic == CANBUS_MAGIC);
     c->index = c->wl.client;
     return 0;
+}
+
+static int join(client_t *c, const char *sock, const char *name, uint16_t roles)
+{
+    return join_node(c, sock, name, roles, 0);
+}
+
+/* A hello the bus must refuse: the STOP reason it answers with, or -1. */
+static int refused_hello(const char *sock, const char *name, uint16_t roles, uint32_t node)
+{
+    int fd = raw_connect(sock);
+    if (fd < 0)
+        return -1;
+    struct canbus_hello h = {.magic = CANBUS_MAGIC, .version = CANBUS_VERSION, .roles = roles,
+                             .node = node};
+    memcpy(h.name, name, strnlen(name, sizeof h.name)); /* a 32-byte name has no NUL */
+    struct canbus_rec r;
+    int reason = -1;
+    if (send(fd, &h, sizeof h, 0) == (ssize_t)sizeof h &&
+        recv(fd, &r, sizeof r, 0) == (ssize_t)sizeof r && r.type == CANBUS_MSG_STOP)
+        reason = (int)r.id;
+    close(fd);
+    return reason;
 }
 
 static void sendrecs(const client_t *c, const struct canbus_rec *r, size_t n)
@@ -167,10 +210,16 @@ static int scenario_main(const char *dir, const char *trace_path)
     char sock[256], stats_path[256];
     snprintf(sock, sizeof sock, "%s/bus.sock", dir);
     snprintf(stats_path, sizeof stats_path, "%s/stats.json", dir);
+    /* The launcher's control channel: FAULT records come over it, not over the socket. */
+    int ctl[2];
+    char ctl_fd[16];
+    REQUIRE(control_pair(ctl, ctl_fd, sizeof ctl_fd) == 0);
     char *argv[] = {(char *)bus_path, "--socket", sock, "--lockstep-clients", "2",
                     "--quantum-us", "1000", "--end-ns", "8000000", "--trace",
-                    (char *)trace_path, "--stats", stats_path, "-q", "--fault-records", NULL};
+                    (char *)trace_path, "--stats", stats_path, "-q", "--control-fd", ctl_fd,
+                    NULL};
     pid_t pid = start_bus(argv, sock);
+    close(ctl[1]);
     client_t p, a, b, g;
     struct canbus_rec got[64], tick;
     int n;
@@ -301,12 +350,14 @@ static int scenario_main(const char *dir, const char *trace_path)
     static struct canbus_rec flood[200];
     memset(flood, 0, sizeof flood);
     sendrecs(&g, flood, 200);
-    /* A FAULT record: drop the first 0x666 frame. */
+    /* A FAULT record from the launcher: drop the first 0x666 frame. Sent before the frames:
+     * the control channel is read first. */
     struct canbus_rec fault = {.type = CANBUS_MSG_FAULT, .flags = 1 /* drop */, .id = 0x666,
                                .t_ns = 0, .aux = 0, .data = {0xFF, 1, 0}};
-    struct canbus_rec qa5[] = {fault, frame(0x666, 0, 8, 4000000), frame(0x666, 0, 8, 4500000),
+    CHECK(send(ctl[0], &fault, sizeof fault, 0) == (ssize_t)sizeof fault);
+    struct canbus_rec qa5[] = {frame(0x666, 0, 8, 4000000), frame(0x666, 0, 8, 4500000),
                                done(5000000)};
-    sendrecs(&a, qa5, 4);
+    sendrecs(&a, qa5, 3);
     struct canbus_rec d5 = done(5000000);
     sendrecs(&b, &d5, 1);
 
@@ -348,6 +399,7 @@ static int scenario_main(const char *dir, const char *trace_path)
     close(b.fd);
     close(p.fd);
     close(g.fd);
+    close(ctl[0]);
 
     CHECK_EQ(wait_bus(pid), 0);
     struct stat st;
@@ -399,7 +451,7 @@ static int scenario_bus_off(const char *dir)
     struct canbus_rec tick;
     int n;
     REQUIRE(join(&obs, sock, "obs", CANBUS_ROLE_CAN) == 0);
-    /* Without --fault-records a client cannot arm a fault: this one would drop every frame. */
+    /* A client of the public socket cannot arm a fault: this one would drop every frame. */
     struct canbus_rec arm = {.type = CANBUS_MSG_FAULT, .flags = 1 /* drop */, .id = 0xFFFFFFFF,
                              .t_ns = 0, .aux = 0, .data = {0xFF, 0, 0}};
     sendrecs(&obs, &arm, 1);
@@ -450,7 +502,7 @@ static int scenario_bus_off(const char *dir)
     CHECK_EQ(wait_bus(pid), 0);
     static char text[1 << 16];
     REQUIRE(read_file(trace, text, sizeof text) > 0);
-    CHECK(strstr(text, "\"fault_records_off\""));
+    CHECK(strstr(text, "\"control_record\""));
     CHECK(!strstr(text, "\"fault_armed\""));
     return 0;
 }
@@ -563,6 +615,102 @@ static int scenario_new_faults(const char *dir)
     return 0;
 }
 
+/* A bus that knows its clients (--client): hellos checked against the declarations, a name
+ * taken refused until its holder has gone (an io partition restarted), an undeclared client
+ * listen-only (it gets the frames; its frames, STOP and FAULT records do nothing), the
+ * launcher's STOP on the control channel; the statistics name them all. */
+static int scenario_admission(const char *dir)
+{
+    char sock[256], stats_path[256], trace[256];
+    snprintf(sock, sizeof sock, "%s/bus5.sock", dir);
+    snprintf(stats_path, sizeof stats_path, "%s/stats5.json", dir);
+    snprintf(trace, sizeof trace, "%s/trace5.jsonl", dir);
+    int ctl[2];
+    char ctl_fd[16];
+    REQUIRE(control_pair(ctl, ctl_fd, sizeof ctl_fd) == 0);
+    char *argv[] = {(char *)bus_path, "--socket", sock, "--lockstep-clients", "1",
+                    "--quantum-us", "1000", "--trace", trace, "--stats", stats_path,
+                    "--control-fd", ctl_fd, "--client", "n1:can+lockstep:1",
+                    "--client", "n1/io:can:1", "--client", "n2/io:can:2", "-q", NULL};
+    pid_t pid = start_bus(argv, sock);
+    close(ctl[1]);
+    /* Node 1's process is this test (its clients: it or its children); node 2's is the bus
+     * itself, so that this test is nobody of node 2. */
+    struct canbus_rec procs[] = {{.type = CANBUS_MSG_PROCESS, .id = 1, .t_ns = getpid()},
+                                 {.type = CANBUS_MSG_PROCESS, .id = 2, .t_ns = pid}};
+    CHECK(send(ctl[0], procs, sizeof procs, 0) == (ssize_t)sizeof procs);
+    client_t n1, io, io2, tool;
+    struct canbus_rec got[64], tick;
+    int n;
+    CHECK_EQ(refused_hello(sock, "n1/io", CANBUS_ROLE_LOCKSTEP, 1), CANBUS_STOP_REFUSED);
+    CHECK_EQ(refused_hello(sock, "n1/io", CANBUS_ROLE_CAN, 2), CANBUS_STOP_REFUSED);
+    CHECK_EQ(refused_hello(sock, "spy", CANBUS_ROLE_CAN | CANBUS_ROLE_LOCKSTEP, 0),
+             CANBUS_STOP_REFUSED);
+    CHECK_EQ(refused_hello(sock, "spy", CANBUS_ROLE_CAN, 7), CANBUS_STOP_REFUSED);
+    CHECK_EQ(refused_hello(sock, "0123456789abcdef0123456789abcdef", CANBUS_ROLE_CAN, 0),
+             CANBUS_STOP_BAD_HELLO);
+    CHECK_EQ(refused_hello(sock, "bad\nname", CANBUS_ROLE_CAN, 0), CANBUS_STOP_BAD_HELLO);
+    CHECK_EQ(refused_hello(sock, "n2/io", CANBUS_ROLE_CAN, 2), CANBUS_STOP_REFUSED);
+    REQUIRE(join_node(&io, sock, "n1/io", CANBUS_ROLE_CAN, 1) == 0);
+    CHECK_EQ(io.wl.flags, 0);
+    CHECK_EQ(refused_hello(sock, "n1/io", CANBUS_ROLE_CAN, 1), CANBUS_STOP_REFUSED);
+    close(io.fd); /* io restarted: its successor takes the name */
+    REQUIRE(join_node(&io2, sock, "n1/io", CANBUS_ROLE_CAN, 1) == 0);
+    REQUIRE(join_node(&tool, sock, "python-can", CANBUS_ROLE_CAN, 0) == 0);
+    CHECK_EQ(tool.wl.flags, CANBUS_WELCOME_LISTEN_ONLY);
+    REQUIRE(join_node(&n1, sock, "n1", CANBUS_ROLE_CAN | CANBUS_ROLE_LOCKSTEP, 1) == 0);
+    REQUIRE(until_tick(&n1, got, 64, &n, &tick) == 0);
+    /* The tool tries a frame of its own, a fault that would drop every frame, a STOP. */
+    struct canbus_rec arm = {.type = CANBUS_MSG_FAULT, .flags = 1 /* drop */, .id = 0xFFFFFFFF,
+                             .data = {0xFF, 0, 0}};
+    struct canbus_rec stop = {.type = CANBUS_MSG_STOP, .id = CANBUS_STOP_REQUESTED};
+    struct canbus_rec evil[] = {frame(0x001, 0, 8, 0), arm, stop};
+    sendrecs(&tool, evil, 3);
+    struct canbus_rec q0[] = {frame(0x123, 0, 8, 0), done(1000000)};
+    sendrecs(&n1, q0, 2);
+    REQUIRE(until_tick(&n1, got, 64, &n, &tick) == 0);
+    CHECK_EQ(tick.type, CANBUS_MSG_TICK); /* the tool's STOP stopped nothing */
+    struct canbus_rec d2 = done(2000000);
+    sendrecs(&n1, &d2, 1);
+    REQUIRE(until_tick(&n1, got, 64, &n, &tick) == 0);
+    CHECK_EQ(tick.type, CANBUS_MSG_TICK);
+    /* The launcher ends the run: the bus stops waiting for n1's DONE (none is sent: the bus
+     * may have closed n1's socket by then). */
+    CHECK(send(ctl[0], &stop, sizeof stop, 0) == (ssize_t)sizeof stop);
+    REQUIRE(until_tick(&n1, got, 64, &n, &tick) == 0);
+    CHECK_EQ(tick.type, CANBUS_MSG_STOP);
+    CHECK_EQ(tick.id, CANBUS_STOP_REQUESTED);
+    uint32_t ids[8];
+    CHECK_EQ(frames_until_stop(&io2, ids, 8), 1); /* the 0x123 alone: nothing was dropped */
+    CHECK_EQ(frames_until_stop(&tool, ids, 8), 1);
+    CHECK_EQ(ids[0], 0x123);
+    close(n1.fd);
+    close(io2.fd);
+    close(tool.fd);
+    close(ctl[0]);
+    CHECK_EQ(wait_bus(pid), 0);
+    static char text[1 << 16];
+    REQUIRE(read_file(stats_path, text, sizeof text) > 0);
+    static const char *const stats_has[] = {
+        "\"frames\":1,", "\"bad_hellos\":2,", "\"refused_hellos\":6,",
+        "\"refused_records\":3,", "\"stopped_by\":\"launcher\"", "\"name\":\"python-can\"",
+        "\"listen_only\":true", "refused: not_as_declared\"}", "refused: undeclared_lockstep\"}",
+        "refused: unknown_node\"}", "refused: duplicate_name\"}", "listen-only, pid ",
+        "refused: not_its_process\"}",
+        "refused 1 FRAME, 1 STOP, 1 FAULT\"}"};
+    for (size_t i = 0; i < sizeof stats_has / sizeof *stats_has; i++)
+        if (!strstr(text, stats_has[i])) {
+            fprintf(stderr, "stats5.json lacks %s\n", stats_has[i]);
+            failures++;
+        }
+    CHECK_EQ(count(text, "{\"what\":\"can_client\",\"detail\":"), 9);
+    REQUIRE(read_file(trace, text, sizeof text) > 0);
+    CHECK(strstr(text, "\"kind\":\"stop_request\",\"by\":\"launcher\"}"));
+    CHECK_EQ(count(text, "\"reason\":\"listen_only\""), 3);
+    CHECK_EQ(count(text, "\"kind\":\"can_tx\""), 1);
+    return 0;
+}
+
 /* SIGTERM: STOP(SIGNAL) to clients, exit 0. */
 static int scenario_signal(const char *dir)
 {
@@ -585,6 +733,7 @@ static int scenario_signal(const char *dir)
     CHECK_EQ(wait_bus(pid), 0);
     static char text[1 << 16];
     CHECK(read_file(stats_path, text, sizeof text) > 0 && strstr(text, "\"stop\":\"signal\""));
+    CHECK(strstr(text, "\"stopped_by\":\"signal\",\"refusals\":[]}"));
     return 0;
 }
 
@@ -612,6 +761,7 @@ int main(int argc, char **argv)
     CHECK(na > 0 && na == nb && memcmp(a, b, (size_t)na) == 0);
     scenario_bus_off(dir);
     scenario_new_faults(dir);
+    scenario_admission(dir);
     scenario_signal(dir);
     if (!failures) {
         char cmd[400];

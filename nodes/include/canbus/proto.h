@@ -8,7 +8,11 @@
  * Connection
  *   1. The client sends one struct canbus_hello datagram.
  *   2. The bus answers with one struct canbus_welcome datagram, or with a single STOP record
- *      whose `id` is a CANBUS_STOP_* reason, and closes.
+ *      whose `id` is a CANBUS_STOP_* reason, and closes. A bus started by the launcher knows
+ *      the clients of the run (ima-canbus --client): a hello naming one of them must ask for
+ *      its roles and node; a name already connected is refused (STOP_REFUSED); a client of
+ *      another name is welcomed LISTEN-ONLY (welcome.flags): it receives the frames, and
+ *      every record it sends is refused. Names are 1..31 printable ASCII characters and a NUL.
  *   3. From then on every datagram, either way, is an array of 32-byte struct canbus_rec
  *      (at most CANBUS_MAX_RECS of them). A datagram whose size is not a multiple of 32, a
  *      record of unknown type or a frame with len > 8 is rejected and counted by the bus.
@@ -39,9 +43,16 @@
  * Real time (--realtime on the bus): the same exchange, but the bus sends the TICK for [T, T+Q)
  * no earlier than epoch + T on CLOCK_MONOTONIC.
  *
- * End: at welcome.end_ns (or when a client sends STOP, e.g. the world after a crash) the bus
- * sends STOP to every client and closes. A LOCKSTEP client that disconnects leaves the
- * lockstep (a dead node does not stop the others).
+ * End: at welcome.end_ns (or when a LOCKSTEP client sends STOP, e.g. the world after a crash,
+ * or the launcher does on its control channel) the bus sends STOP to every client and closes.
+ * A LOCKSTEP client that disconnects leaves the lockstep (a dead node does not stop the others).
+ *
+ * Control channel (ima-canbus --control-fd N): the launcher's end of a socketpair the bus
+ * inherits, never reachable by a path. It carries the same 32-byte records, of three types
+ * only: FAULT (arm a bus fault), STOP (end the run, stopped_by "launcher") and PROCESS (the
+ * process of a node, whose declared clients must be it or its children: without it a
+ * declared client is refused). A FAULT or PROCESS record, or a STOP from a client without the
+ * LOCKSTEP role, on the public socket is refused and counted.
  */
 #ifndef CANBUS_PROTO_H
 #define CANBUS_PROTO_H
@@ -68,6 +79,7 @@ struct canbus_hello {
 };
 
 #define CANBUS_WELCOME_REALTIME 0x1
+#define CANBUS_WELCOME_LISTEN_ONLY 0x2 /* an undeclared client: whatever it sends is refused */
 
 struct canbus_welcome {
     uint32_t magic;
@@ -87,11 +99,14 @@ enum canbus_rec_type {
                              a --realtime bus: data = how late it released the quantum on its
                              wall clock (int64 ns, little-endian), else zeros */
     CANBUS_MSG_DONE = 3,  /* LOCKSTEP client -> bus: finished everything before t_ns */
-    CANBUS_MSG_STOP = 4,  /* either way: the run ends; id = CANBUS_STOP_* reason */
+    CANBUS_MSG_STOP = 4,  /* bus -> client: the run ends; id = CANBUS_STOP_* reason. LOCKSTEP
+                             client or control channel -> bus: end the run */
     CANBUS_MSG_ERROR = 5, /* bus -> CAN clients: an error frame on the wire (id = the frame's
                              identifier, t_ns = when, data[0] = sender, data[1] = its state) */
-    CANBUS_MSG_FAULT = 6, /* client -> bus: arm a bus fault, if the bus runs with
-                             --fault-records (see nodes/README.md) */
+    CANBUS_MSG_FAULT = 6, /* control channel -> bus: arm a bus fault (nodes/README.md) */
+    CANBUS_MSG_PROCESS = 7, /* control channel -> bus: id = a node (0: the world), t_ns = the
+                               pid of its process (a SKE, the world): its declared clients
+                               must be that process or a child of it (its partitions) */
 };
 
 /* ERROR record, in full (bus -> every CAN client, delivered like a frame, in wire order):
@@ -102,7 +117,7 @@ enum canbus_rec_type {
  *   on the wire, 0 for a state change alone (a forced bus-off, a recovery to ACTIVE),
  *   data[3..4] = the sender's transmit error counter, little-endian.
  *
- * FAULT record (client -> bus), arms a fault in the bus; kinds in `flags`:
+ * FAULT record (control channel -> bus), arms a fault in the bus; kinds in `flags`:
  *   1 drop, 2 corrupt, 3 delay, 4 babble, 5 bus_off, 6 duplicate, 7 transceiver_cut,
  *   8 rx_drop (faultinject/can/canbus__fault.h).
  *   id      identifier to match, 0xFFFFFFFF for any (not used by babble and bus_off)
@@ -127,10 +142,11 @@ enum canbus_rec_type {
 enum canbus_stop_reason {
     CANBUS_STOP_END = 0,        /* end of the run */
     CANBUS_STOP_REQUESTED = 1,  /* a client asked for it */
-    CANBUS_STOP_BAD_HELLO = 2,  /* wrong magic, version or roles */
+    CANBUS_STOP_BAD_HELLO = 2,  /* wrong magic, version, roles or name */
     CANBUS_STOP_LATE_JOIN = 3,  /* LOCKSTEP client after the start */
     CANBUS_STOP_FULL = 4,       /* too many clients */
     CANBUS_STOP_SIGNAL = 5,     /* the bus process was interrupted */
+    CANBUS_STOP_REFUSED = 6,    /* not as the launcher declared it, or its name is taken */
 };
 
 /* Error state of a CAN controller (ERROR record data[1]) */

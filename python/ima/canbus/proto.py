@@ -17,6 +17,7 @@ ROLE_LOCKSTEP = 0x2
 ROLE_OWN = 0x4
 
 WELCOME_REALTIME = 0x1
+WELCOME_LISTEN_ONLY = 0x2  # an undeclared client: whatever it sends is refused
 
 # Record types (enum canbus_rec_type).
 MSG_FRAME = 1
@@ -25,6 +26,7 @@ MSG_DONE = 3
 MSG_STOP = 4
 MSG_ERROR = 5
 MSG_FAULT = 6
+MSG_PROCESS = 7
 
 # FRAME flags.
 FRAME_EFF = 0x1
@@ -37,14 +39,16 @@ STOP_BAD_HELLO = 2
 STOP_LATE_JOIN = 3
 STOP_FULL = 4
 STOP_SIGNAL = 5
+STOP_REFUSED = 6
 
 STOP_REASONS = {
     STOP_END: "end of the run",
     STOP_REQUESTED: "a client asked for it",
-    STOP_BAD_HELLO: "wrong magic, version or roles",
+    STOP_BAD_HELLO: "wrong magic, version, roles or name",
     STOP_LATE_JOIN: "LOCKSTEP client after the start",
     STOP_FULL: "too many clients",
     STOP_SIGNAL: "the bus process was interrupted",
+    STOP_REFUSED: "not as the launcher declared it, or its name is taken",
 }
 
 # Error state of a CAN controller (ERROR record data[1]).

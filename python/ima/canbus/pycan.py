@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """python-can interface "ima": attach python-can tools (logger, viewer, player, cantools monitor)
-to the live virtual CAN bus, e.g. `python -m can.logger -i ima -c RUN/can.sock`."""
+to the live virtual CAN bus, e.g. `python -m can.logger -i ima -c RUN/can.sock`. A launched
+run's bus admits them listen-only (they are not among its declared clients): they receive every
+frame, and sending raises; a bus started by hand takes their frames too."""
 
 from __future__ import annotations
 
@@ -25,6 +27,7 @@ class ImaBus(can.BusABC):
     `--bus-kwargs`): `name` (client name on the bus, default "python-can"), `node` (default 0),
     `end_on_stop` (default False: after the run ends the bus stays quiet, as a real idle bus
     would, until the tool is interrupted; True: recv raises CanOperationError instead).
+    On a launched run's bus the tool is listen-only (`listen_only`): send raises.
     """
 
     def __init__(self, channel, can_filters=None, receive_own_messages: bool = False,
@@ -61,6 +64,8 @@ class ImaBus(can.BusABC):
         self._sock = sock
         self.client = self.welcome.client
         self.bitrate = self.welcome.bitrate
+        # a launched run's bus: receive only (nodes/README.md, "Who may join")
+        self.listen_only = bool(self.welcome.flags & proto.WELCOME_LISTEN_ONLY)
         super().__init__(channel=channel, can_filters=can_filters, **kwargs)
 
     def fileno(self) -> int:
@@ -133,6 +138,10 @@ class ImaBus(can.BusABC):
     def send(self, msg: can.Message, timeout: float | None = None) -> None:
         if self.stopped is not None:
             raise can.CanOperationError(f"the IMA CAN bus at {self.channel} has ended the run")
+        if self.listen_only:
+            raise can.CanOperationError(
+                f"the IMA CAN bus at {self.channel} admits this tool listen-only (a run's bus "
+                "takes frames from its own clients only): nothing it sends is delivered")
         if msg.is_fd or msg.dlc > 8 or len(msg.data) > 8:
             raise can.CanOperationError("the IMA CAN bus carries classic CAN frames only "
                                         "(at most 8 data bytes)")

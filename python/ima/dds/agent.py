@@ -112,11 +112,12 @@ def _security_dir(security, run_dir: Path, nodes: int, domain: int) -> Path | No
 
 def start_agent(node: int, nodes: int, run_dir: Path, domain: int, *, realtime: bool = False,
                 extra: list[str] | tuple = (), wait: bool = False,
-                security="sign") -> Agent:
-    """Starts node's agent with its socket, trace, statistics and stderr in run_dir.
-    `security`: a DDS Security mode (ima.dds.security.MODES; the files are made in run_dir)
-    or the Material of a run; "off" for none (a Python cyclonedds participant can then talk
-    to the agent: it has no security plugins)."""
+                security="sign", fds: tuple[int, ...] = ()) -> Agent:
+    """Starts node's agent with its socket, trace, statistics and stderr in run_dir; `fds`
+    are inherited (e.g. --ske-pid-fd's). `security`: a DDS Security mode
+    (ima.dds.security.MODES; the files are made in run_dir) or the Material of a run; "off"
+    for none (a Python cyclonedds participant can then talk to the agent: it has no security
+    plugins)."""
     run_dir = Path(run_dir)
     sock = run_dir / f"xch{node}.sock"
     trace = run_dir / f"dds{node}.jsonl"
@@ -132,9 +133,9 @@ def start_agent(node: int, nodes: int, run_dir: Path, domain: int, *, realtime: 
         args += ["--security", str(sec_dir)]
     args += [str(a) for a in extra]
     try:
-        pass_fds = (domain_lock_fd(domain),)
+        pass_fds = (domain_lock_fd(domain), *fds)
     except ImaError:
-        pass_fds = ()
+        pass_fds = tuple(fds)
     with open(err, "wb") as errf:
         proc = subprocess.Popen(args, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                 stderr=errf, env=dds_env(), pass_fds=pass_fds)

@@ -60,6 +60,7 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
     # Every node's io partition joins in the first quantum, all at once: fixed indices keep
     # the bus trace the same from run to run.
     bus += ["--client-order", ",".join([*names, "world", *(f"{x}/io" for x in names)])]
+    bus += declared_clients(names, index)
     if opts.realtime:
         bus.append("--realtime")
 
@@ -101,6 +102,16 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
             "--output-dir", str(run_dir),  # the partitions' output files (the recordings)
             "-q", *(["--trace-port-hashes"] if opts.port_hashes else []),
             *faults.ske.get(node, []), *switches.get(node, []), "--", str(modules[node])]
+    return out
+
+
+def declared_clients(names: list[str], index: dict[str, int]) -> list[str]:
+    """The bus's --client words: every client of the run as its hello will say (nodes/README.md,
+    "Who may join"); another name joins listen-only, a second one of these names is refused."""
+    out = ["--client", "world:can+lockstep:0"]
+    for node in names:
+        out += ["--client", f"{node}:lockstep:{index[node]}",
+                "--client", f"{node}/io:can:{index[node]}"]
     return out
 
 

@@ -64,15 +64,17 @@ class Processes:
         self.failed: dict[str, str] = {}  # processes that failed before the end, and why
 
     def start(self, name: str, cmd: list[str], env: dict[str, str] | None = None,
-              stdout=None, cwd: Path | None = None) -> subprocess.Popen:
-        """Starts `cmd` with its standard error (and output, unless piped) in <name>.log."""
+              stdout=None, cwd: Path | None = None,
+              pass_fds: tuple[int, ...] = ()) -> subprocess.Popen:
+        """Starts `cmd` with its standard error (and output, unless piped) in <name>.log;
+        `pass_fds` are inherited (the launcher's channels)."""
         logf = open(self.run_dir / log_name(name), "wb")  # noqa: SIM115 - closed in close()
         self.logs.append(logf)
         try:
             proc = subprocess.Popen(
                 cmd, stdout=stdout if stdout is not None else logf, stderr=logf,
                 stdin=subprocess.DEVNULL, env=env, cwd=cwd, process_group=0,
-                preexec_fn=_preexec,
+                preexec_fn=_preexec, pass_fds=pass_fds,
             )
         except OSError as exc:
             raise ImaError(f"cannot start {cmd[0]}: {exc.strerror}") from exc
@@ -209,12 +211,14 @@ def follow_world(world: subprocess.Popen, on_status: Callable[[dict], None] | No
 
 class Watch:
     """Ends the run when a process fails before the end (the world would wait for its quanta
-    for ever): the bus is told to end it, which stops the world. A node the run kills on
-    purpose is not a failure: the rest of that node (its DDS agent) is killed too, as a dead
-    processor's would be."""
+    for ever): the bus is told to end it (on its control channel), which stops the world. A
+    node the run kills on purpose is not a failure: the rest of that node (its DDS agent) is
+    killed too, as a dead processor's would be."""
 
-    def __init__(self, procs: Processes, kills: dict[str, float]) -> None:
+    def __init__(self, procs: Processes, kills: dict[str, float],
+                 stop_run: Callable[[], bool]) -> None:
         self.procs, self.kills = procs, kills
+        self.stop_run = stop_run  # the bus's control channel: stopped_by "launcher"
         self.killed: dict[str, float] = {}
         self.stopping = threading.Event()  # Ctrl-C: the processes end because they are told to
 
@@ -246,9 +250,7 @@ class Watch:
                     continue
                 procs.failed[name] = f"exited with {code}: {procs.log_tail(name)}"
             if procs.failed:
-                if bus is not None and bus.poll() is None:
-                    bus.send_signal(signal.SIGTERM)
-                else:
+                if bus is None or bus.poll() is not None or not self.stop_run():
                     world.terminate()
                 return
             time.sleep(0.1)

@@ -56,6 +56,18 @@ def print_redundancy(s: dict, console) -> None:
         console.print(f"  {ev['t_s']:9.3f} s {ev['node']} monitor: {ev['text']}", markup=False)
 
 
+def print_refused(s: dict, console) -> None:
+    """Who stopped the run early, and what its processes refused (docs/security.md)."""
+    if s.get("stopped_by") not in (None, "signal"):  # Ctrl-C says so at the top already
+        console.print(f"Run stopped early by {s['stopped_by']}", markup=False)
+    refused = s.get("refused") or []
+    if refused:
+        console.print(f"[bold yellow]Refused[/] {len(refused)} time(s) (summary.json "
+                      "`refused`):")
+        for e in refused[:5]:
+            console.print(f"  {e.get('by')}: {e['what']}: {e['detail']}", markup=False)
+
+
 def print_summary(s: dict, console) -> None:
     if s.get("interrupted"):
         at = s.get("interrupted_at_s")
@@ -69,3 +81,4 @@ def print_summary(s: dict, console) -> None:
         killed = [f"{k['node']}@{k['t_s']:g}s" for k in s.get("killed", [])]
         if killed:
             console.print(f"Node stopped on purpose: {', '.join(killed)}")
+    print_refused(s, console)

@@ -32,6 +32,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from ima import outdir
+from ima.canbus.control import BusControl
 from ima.deploy.model import canbus_socket_name, dds_socket_name
 from ima.errors import ImaError
 from ima.launch import commands, procs
@@ -104,6 +105,15 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
     kills, hangs = plan.kills, plan.hangs
     procs_plan = commands.plan(system, opts, run_dir, sock_dir, pilot, deployed.modules, plan,
                                domain, security)
+    # The launcher's channels, inherited, never paths: the bus's control channel (faults,
+    # stop) and, per agent, the pipe that tells it its node's SKE (only that SKE's partitions
+    # may be its io).
+    control = BusControl()
+    procs_plan.bus += ["--control-fd", str(control.child_fd)]
+    ske_pipes = {name: os.pipe() for name in procs_plan.agents}  # agent -> (read, write)
+    for name, (r, _) in ske_pipes.items():
+        procs_plan.agents[name] = procs_plan.agents[name] + ["--ske-pid-fd", str(r)]
+    open_fds = {fd for pipe in ske_pipes.values() for fd in pipe}  # closed once, at most
     (run_dir / "launch.json").write_text(json.dumps({
         "kind": opts.kind, "system": str(system.path), "nodes": names, "seed": opts.seed,
         "duration_s": opts.duration_s, "pilot": str(pilot), "turbulence": opts.turbulence,
@@ -159,7 +169,8 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
 
             netns = netns_mod.Namespaces(names, run_dir)
             netns.create()
-        ps.start("canbus", procs_plan.bus)
+        ps.start("canbus", procs_plan.bus, pass_fds=(control.child_fd,))
+        control.started()
         procs.wait_for_socket(procs_plan.bus_socket, ps)
         _link(run_dir / canbus_socket_name(), procs_plan.bus_socket)
         agents = {}
@@ -169,7 +180,9 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
                 cfg = netns.dds_config(node, run_dir)
                 cmd = netns.wrap(node, [c if c != str(system.dds["config"]) else str(cfg)
                                         for c in cmd] + ["--bind-device", netns.device])
-            agents[name] = ps.start(name, cmd, stdout=subprocess.PIPE)
+            agents[name] = ps.start(name, cmd, stdout=subprocess.PIPE,
+                                    pass_fds=(ske_pipes[name][0],))
+            _close(open_fds, ske_pipes[name][0])
         procs.wait_ready(agents, ps, _READY_TIMEOUT_S)
         netns_pids: list[int] = []
         for k, node in enumerate(names, start=1):
@@ -177,13 +190,18 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
             if netns is not None:
                 cmd = netns.wrap(node, cmd)
             proc = ps.start(node, cmd, cwd=sock_dir)
+            # its clients on the bus: the SKE and its partitions
+            control.process(next(n.index for n in system.nodes if n.name == node), proc.pid)
+            if f"{node}/dds" in ske_pipes:
+                _tell_ske(open_fds, ske_pipes[f"{node}/dds"][1], proc.pid)
             if netns is not None:
                 netns_pids.append(proc.pid)
             procs.wait_joined(procs_plan.bus_socket, k, ps, pids=tuple(netns_pids))
         world = ps.start("world", procs_plan.world, stdout=subprocess.PIPE)
-        watch = procs.Watch(ps, kills)
+        control.process(0, world.pid)
+        watch = procs.Watch(ps, kills, control.stop)
         threading.Thread(target=watch, daemon=True).start()
-        procs.follow_world(world, _watching(on_status, stop_when, ps))
+        procs.follow_world(world, _watching(on_status, stop_when, control))
         # A hung processor is switched off at the end of the run: its frozen processes would
         # not even take a SIGTERM. Its agent ends with the others.
         for node in hangs:
@@ -198,6 +216,9 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
     finally:
         ps.stop()
         ps.close()
+        control.close()
+        for fd in list(open_fds):  # of agents never started, or whose SKE never was
+            _close(open_fds, fd)
         if netns is not None:
             netns.destroy()
         for s, h in previous.items():
@@ -230,8 +251,25 @@ def _link(link: Path, target: Path) -> None:
         pass  # a tool then finds the socket from launch.json's `socket`
 
 
+def _close(open_fds: set[int], fd: int) -> None:
+    """Closes a descriptor of ours once: its number may be another file's afterwards."""
+    if fd in open_fds:
+        open_fds.discard(fd)
+        os.close(fd)
+
+
+def _tell_ske(open_fds: set[int], w: int, pid: int) -> None:
+    """Writes the SKE's pid to its node's agent (--ske-pid-fd), then closes the pipe."""
+    try:
+        os.write(w, f"{pid}\n".encode())
+    except OSError:
+        pass  # the agent has gone: the watch reports it
+    finally:
+        _close(open_fds, w)
+
+
 def _watching(on_status: Callable[[dict], None] | None, stop_when: Callable[[dict], bool] | None,
-              ps: procs.Processes) -> Callable[[dict], None] | None:
+              control: BusControl) -> Callable[[dict], None] | None:
     """The world's status lines to on_status; the bus told to end the run at the first one
     stop_when accepts (a run that resolves a fault's condition need go no further)."""
     if stop_when is None:
@@ -244,7 +282,5 @@ def _watching(on_status: Callable[[dict], None] | None, stop_when: Callable[[dic
             on_status(st)
         if not stopped and stop_when(st):
             stopped = True
-            bus = ps.procs.get("canbus")
-            if bus is not None and bus.poll() is None:
-                bus.send_signal(signal.SIGTERM)
+            control.stop()
     return watch

@@ -54,11 +54,36 @@ def voting(run_dir: Path) -> dict[str, Any]:
 
 
 def _dds_stats(run_dir: Path, node_index: int) -> dict | None:
-    path = run_dir / f"dds{node_index}.json"
+    return _stats(run_dir / f"dds{node_index}.json")
+
+
+def _stats(path: Path) -> dict | None:
     try:
-        return json.loads(path.read_text())
+        st = json.loads(path.read_text())
     except (OSError, ValueError):
         return None
+    return st if isinstance(st, dict) else None
+
+
+def refused(run_dir: Path, nodes: list[str]) -> list[dict]:
+    """What the run's processes refused, one list from the `refusals` list of every statistics
+    file that has one: the bus's (`can_client`), each DDS agent's (`io_client`, ...); each
+    entry {"what", "detail"} with `by`, the process that refused it (docs/flight.md)."""
+    sources = [("canbus", run_dir / "canbus.json")]
+    sources += [(f"{node}/dds", run_dir / f"dds{k}.json") for k, node in enumerate(nodes, 1)]
+    out = []
+    for by, path in sources:
+        for entry in (_stats(path) or {}).get("refusals") or []:
+            if isinstance(entry, dict) and isinstance(entry.get("what"), str):
+                out.append({"what": entry["what"], "detail": str(entry.get("detail", "")),
+                            "by": by})
+    return out
+
+
+def stopped_by(run_dir: Path) -> str | None:
+    """Who ended the run before its end: a bus client's name (the world after a crash),
+    "launcher" or "signal"; None when it flew to its end."""
+    return (_stats(run_dir / "canbus.json") or {}).get("stopped_by")
 
 
 def dds_refused(dds: dict[str, dict]) -> list[dict]:
@@ -129,7 +154,8 @@ def summarise(run_dir: Path, pilot: Path, duration_s: float, nodes: list[str],
         summary["dds"] = dds
         summary["dds_security"] = _security_mode(run_dir) if any(
             st.get("security") for st in dds.values()) else "off"
-    summary["refused"] = dds_refused(dds)
+    summary["stopped_by"] = stopped_by(run_dir)
+    summary["refused"] = refused(run_dir, nodes) + dds_refused(dds)
     write(run_dir, summary)
     return summary
 

@@ -6,13 +6,11 @@ the tests that judge it from the world's truth and the recorded traces."""
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
 from ima.launch import options as launch_options
-from ima.flight.summary import read_jsonl
 from ima.launch import run as launch_run
 from ima.launch import summary as launch_summary
 
@@ -22,20 +20,7 @@ HERE = Path(__file__).resolve().parent
 sys.path[:0] = [str(HERE), str(HERE.parent / "flight")]
 
 from flight_helpers import fly_unless_host_stalled  # noqa: E402
-from launch_helpers import TRIPLEX  # noqa: E402
-
-
-@dataclass
-class Run:
-    run_dir: Path
-    summary: dict
-    result: launch_options.LaunchRun
-
-    def truth_between(self, t0_s: float, t1_s: float) -> list[dict]:
-        return [r for r in read_jsonl(self.run_dir / "truth.jsonl") if t0_s <= r["t_ns"] / 1e9 < t1_s]
-
-    def records(self, name: str, kind: str | None = None) -> list[dict]:
-        return [r for r in read_jsonl(self.run_dir / name) if kind is None or r.get("kind") == kind]
+from launch_helpers import TRIPLEX, Run  # noqa: E402
 
 
 class LaunchCache:

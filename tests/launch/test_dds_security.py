@@ -18,9 +18,8 @@ from pathlib import Path
 
 import pytest
 from flight_helpers import fly_unless_host_stalled
-from launch_helpers import TRIPLEX
+from launch_helpers import TRIPLEX, Run
 
-from conftest import Run
 from ima import dds, paths
 from ima.dds import security
 from ima.launch import options as launch_options

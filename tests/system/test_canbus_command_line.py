@@ -63,7 +63,7 @@ def test_a_run_with_every_option_it_can_take_ends_on_time(tmp_path):
     stats = tmp_path / "stats.json"
     p = _bus("--socket", str(tmp_path / "can.sock"), "--duration", "0.01", "-q",
              "--stats", str(stats), "--kill-node", "2@5", "--hang-node", "3@5",
-             "--client-order", "a,b", "--bus-off-recovery", "--fault-records",
+             "--client-order", "a,b", "--bus-off-recovery", "--client", "a:can+lockstep:1",
              "--max-rejects", "3", "--send-timeout-ms", "100", "--client-buffer", "4096",
              "--gap-bits", "3", "--bitrate", "500000", "--quantum-us", "1000",
              "--max-clients", "4", "--lockstep-clients", "0")

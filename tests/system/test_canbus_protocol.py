@@ -121,7 +121,7 @@ def test_what_the_bus_refuses_and_rejects(tmp_path):
     assert rejects == [
         ("", "bad_hello"), ("x", "bad_hello"), ("odd", "bad_hello"), ("node2", "late_join"),
         ("fourth", "full"), ("node1", "len"), ("node1", "flags"), ("node1", "id"),
-        ("node1", "bad_done"), ("node1", "type"), ("node1", "fault_records_off"),
+        ("node1", "bad_done"), ("node1", "type"), ("node1", "control_record"),
         ("node1", "size"), ("logger", "frame_without_can_role"),
         *[("noisy", "type")] * 9,
     ], rejects

@@ -168,16 +168,14 @@ static inline void apex__user_copy(bool on) { apex__in_user_copy = on; }
 /* The caller gave an address the service cannot use where it can return no error code (a
  * null or unwritable RETURN_CODE), or one that faulted: an ILLEGAL_REQUEST for the health
  * monitor, the same path as a fault inside apex__user_copy. The caller does not go on. */
-void apex__invalid_address(const void *address);
+_Noreturn void apex__invalid_address(const void *address);
 
 /* The addresses a caller gives a service (apex__user.h, inline: every service call checks
  * some). Every service starts with apex__enter: it brings time up to date and checks
- * RETURN_CODE; false means the service must return at once (the health monitor has the
- * caller's ILLEGAL_REQUEST). The others check an address: a null one, or one that cannot be
- * read (or written, for an output), is an ILLEGAL_REQUEST, as when a message copy faults;
- * they return false only if the health monitor let the caller go on, and the service then
- * answers INVALID_PARAM. apex__addr_ok checks a message address for null only: its copy is
- * bracketed by apex__user_copy. */
+ * RETURN_CODE. The others check an address: a null one, or one that cannot be read (or
+ * written, for an output), is an ILLEGAL_REQUEST, as when a message copy faults. A check
+ * that fails does not return, so a service needs no path for it. apex__check_addr checks a
+ * message address for null only: its copy is bracketed by apex__user_copy. */
 #include "apex__user.h"
 
 /* Sampling ports (sampling.c), shared with the Part 2 extensions (sampling_ext.c). VALID when

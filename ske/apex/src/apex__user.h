@@ -37,53 +37,42 @@ static inline void apex__probe(const void *p, size_t n, bool write)
 }
 
 /* A null address takes the path of any other address the caller cannot use: the health
- * monitor has its ILLEGAL_REQUEST and the call does not go on. The false return is for a
- * caller the health monitor let go on. */
-static inline bool apex__null_address(void)
-{
-    apex__invalid_address(NULL);
-    return false;
-}
-
-static inline bool apex__enter(RETURN_CODE_TYPE *rc)
+ * monitor has its ILLEGAL_REQUEST, and the calling process stops there (apex__invalid_address
+ * does not return). So every check below either passes or never comes back. */
+static inline void apex__enter(RETURN_CODE_TYPE *rc)
 {
     apex__sync();
-    if (!rc) {
+    if (!rc)
         apex__invalid_address(NULL); /* nowhere to say anything */
-        return false;
-    }
     apex__probe(rc, sizeof *rc, true);
-    return true;
 }
 
-static inline bool apex__addr_ok(const void *p) { return p ? true : apex__null_address(); }
-
-static inline bool apex__out_ok(void *p, size_t n)
+static inline void apex__check_addr(const void *p)
 {
     if (!p)
-        return apex__null_address();
+        apex__invalid_address(NULL);
+}
+
+static inline void apex__check_out(void *p, size_t n)
+{
+    apex__check_addr(p);
     apex__probe(p, n, true);
-    return true;
 }
 
-static inline bool apex__in_ok(const void *p, size_t n)
+static inline void apex__check_in(const void *p, size_t n)
 {
-    if (!p)
-        return apex__null_address();
+    apex__check_addr(p);
     apex__probe(p, n, false);
-    return true;
 }
 
 /* A name parameter: readable up to its NUL or MAX_NAME_LENGTH characters. */
-static inline bool apex__name_ok(const char *name)
+static inline void apex__check_name(const char *name)
 {
-    if (!name)
-        return apex__null_address();
+    apex__check_addr(name);
     apex__user_copy(true);
     volatile size_t n = strnlen(name, MAX_NAME_LENGTH); /* volatile: the read must happen */
     apex__user_copy(false);
     (void)n;
-    return true;
 }
 
 #endif

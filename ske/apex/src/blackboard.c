@@ -19,12 +19,9 @@ void CREATE_BLACKBOARD(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_intra_t *in = &apex__intra;
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(BLACKBOARD_NAME) || !apex__out_ok(BLACKBOARD_ID, sizeof *BLACKBOARD_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(BLACKBOARD_NAME);
+    apex__check_out(BLACKBOARD_ID, sizeof *BLACKBOARD_ID);
     if (in->n_blackboards >= MAX_NUMBER_OF_BLACKBOARDS) {
         *RETURN_CODE = INVALID_CONFIG;
         return;
@@ -67,13 +64,13 @@ void DISPLAY_BLACKBOARD(
     /*in */ MESSAGE_SIZE_TYPE LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = blackboard_index(BLACKBOARD_ID);
-    if (k < 0 || LENGTH > apex__intra.blackboards[k].max_size || LENGTH <= 0 || !apex__addr_ok(MESSAGE_ADDR)) {
+    if (k < 0 || LENGTH > apex__intra.blackboards[k].max_size || LENGTH <= 0) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
+    apex__check_addr(MESSAGE_ADDR);
     apex_blackboard_t *bb = &apex__intra.blackboards[k];
     apex__copy_message(bb->data, MESSAGE_ADDR, (size_t)LENGTH);
     bb->len = LENGTH;
@@ -99,15 +96,15 @@ void READ_BLACKBOARD(
     /*out*/ MESSAGE_SIZE_TYPE *LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = blackboard_index(BLACKBOARD_ID);
     int64_t until;
-    if (k < 0 || !apex__time_out(TIME_OUT, &until) || !apex__addr_ok(MESSAGE_ADDR) ||
-        !apex__out_ok(LENGTH, sizeof *LENGTH)) {
+    if (k < 0 || !apex__time_out(TIME_OUT, &until)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
+    apex__check_addr(MESSAGE_ADDR);
+    apex__check_out(LENGTH, sizeof *LENGTH);
     const apex_blackboard_t *bb = &apex__intra.blackboards[k];
     if (bb->empty == OCCUPIED) {
         apex__copy_message(MESSAGE_ADDR, bb->data, (size_t)bb->len);
@@ -140,8 +137,7 @@ void CLEAR_BLACKBOARD(
     /*in */ BLACKBOARD_ID_TYPE BLACKBOARD_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = blackboard_index(BLACKBOARD_ID);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -156,12 +152,9 @@ void GET_BLACKBOARD_ID(
     /*out*/ BLACKBOARD_ID_TYPE *BLACKBOARD_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(BLACKBOARD_NAME) || !apex__out_ok(BLACKBOARD_ID, sizeof *BLACKBOARD_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(BLACKBOARD_NAME);
+    apex__check_out(BLACKBOARD_ID, sizeof *BLACKBOARD_ID);
     int k = apex__find_named(apex__intra.blackboards, sizeof apex__intra.blackboards[0],
                              apex__intra.n_blackboards, BLACKBOARD_NAME);
     if (k < 0) {
@@ -177,13 +170,13 @@ void GET_BLACKBOARD_STATUS(
     /*out*/ BLACKBOARD_STATUS_TYPE *BLACKBOARD_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = blackboard_index(BLACKBOARD_ID);
-    if (k < 0 || !apex__out_ok(BLACKBOARD_STATUS, sizeof *BLACKBOARD_STATUS)) {
+    if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
+    apex__check_out(BLACKBOARD_STATUS, sizeof *BLACKBOARD_STATUS);
     const apex_blackboard_t *bb = &apex__intra.blackboards[k];
     BLACKBOARD_STATUS->EMPTY_INDICATOR = bb->empty;
     BLACKBOARD_STATUS->MAX_MESSAGE_SIZE = bb->max_size;

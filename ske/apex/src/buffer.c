@@ -45,12 +45,9 @@ void CREATE_BUFFER(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_intra_t *in = &apex__intra;
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(BUFFER_NAME) || !apex__out_ok(BUFFER_ID, sizeof *BUFFER_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(BUFFER_NAME);
+    apex__check_out(BUFFER_ID, sizeof *BUFFER_ID);
     if (in->n_buffers >= MAX_NUMBER_OF_BUFFERS) {
         *RETURN_CODE = INVALID_CONFIG;
         return;
@@ -101,12 +98,15 @@ void SEND_BUFFER(
     /*in */ SYSTEM_TIME_TYPE TIME_OUT,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = buffer_index(BUFFER_ID);
     int64_t until;
-    if (k < 0 || LENGTH > apex__intra.buffers[k].max_size || LENGTH <= 0 || !apex__addr_ok(MESSAGE_ADDR) ||
-        !apex__time_out(TIME_OUT, &until)) {
+    if (k < 0 || LENGTH > apex__intra.buffers[k].max_size || LENGTH <= 0) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    apex__check_addr(MESSAGE_ADDR);
+    if (!apex__time_out(TIME_OUT, &until)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
@@ -146,15 +146,15 @@ void RECEIVE_BUFFER(
     /*out*/ MESSAGE_SIZE_TYPE *LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = buffer_index(BUFFER_ID);
     int64_t until;
-    if (k < 0 || !apex__time_out(TIME_OUT, &until) || !apex__addr_ok(MESSAGE_ADDR) ||
-        !apex__out_ok(LENGTH, sizeof *LENGTH)) {
+    if (k < 0 || !apex__time_out(TIME_OUT, &until)) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
+    apex__check_addr(MESSAGE_ADDR);
+    apex__check_out(LENGTH, sizeof *LENGTH);
     apex_buffer_t *b = &apex__intra.buffers[k];
     if (b->count > 0) {
         MESSAGE_SIZE_TYPE len = pop(b, MESSAGE_ADDR);
@@ -195,12 +195,9 @@ void GET_BUFFER_ID(
     /*out*/ BUFFER_ID_TYPE *BUFFER_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(BUFFER_NAME) || !apex__out_ok(BUFFER_ID, sizeof *BUFFER_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(BUFFER_NAME);
+    apex__check_out(BUFFER_ID, sizeof *BUFFER_ID);
     int k = apex__find_named(apex__intra.buffers, sizeof apex__intra.buffers[0],
                              apex__intra.n_buffers, BUFFER_NAME);
     if (k < 0) {
@@ -216,13 +213,13 @@ void GET_BUFFER_STATUS(
     /*out*/ BUFFER_STATUS_TYPE *BUFFER_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = buffer_index(BUFFER_ID);
-    if (k < 0 || !apex__out_ok(BUFFER_STATUS, sizeof *BUFFER_STATUS)) {
+    if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
+    apex__check_out(BUFFER_STATUS, sizeof *BUFFER_STATUS);
     const apex_buffer_t *b = &apex__intra.buffers[k];
     BUFFER_STATUS->NB_MESSAGE = b->count;
     BUFFER_STATUS->MAX_NB_MESSAGE = b->max_nb;

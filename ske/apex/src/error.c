@@ -8,12 +8,13 @@ void REPORT_APPLICATION_MESSAGE(
     /*in */ MESSAGE_SIZE_TYPE LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (LENGTH < 0 || LENGTH > MAX_ERROR_MESSAGE_SIZE || (LENGTH > 0 && !apex__addr_ok(MESSAGE_ADDR))) {
+    apex__enter(RETURN_CODE);
+    if (LENGTH < 0 || LENGTH > MAX_ERROR_MESSAGE_SIZE) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
+    if (LENGTH > 0)
+        apex__check_addr(MESSAGE_ADDR);
     PROCESS_ID_TYPE id = apex__rt.current ? apex__rt.current->id : 0;
     apex__user_copy(true);
     apex__event(SKE_EV_APP_MESSAGE, id, 0, MESSAGE_ADDR, (uint32_t)LENGTH);

@@ -17,12 +17,9 @@ void CREATE_EVENT(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_intra_t *in = &apex__intra;
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(EVENT_NAME) || !apex__out_ok(EVENT_ID, sizeof *EVENT_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(EVENT_NAME);
+    apex__check_out(EVENT_ID, sizeof *EVENT_ID);
     if (in->n_events >= MAX_NUMBER_OF_EVENTS) {
         *RETURN_CODE = INVALID_CONFIG;
         return;
@@ -52,8 +49,7 @@ void SET_EVENT(
     /*in */ EVENT_ID_TYPE EVENT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = event_index(EVENT_ID);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -75,8 +71,7 @@ void RESET_EVENT(
     /*in */ EVENT_ID_TYPE EVENT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = event_index(EVENT_ID);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -91,8 +86,7 @@ void WAIT_EVENT(
     /*in */ SYSTEM_TIME_TYPE TIME_OUT,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = event_index(EVENT_ID);
     int64_t until;
     if (k < 0 || !apex__time_out(TIME_OUT, &until)) {
@@ -119,12 +113,9 @@ void GET_EVENT_ID(
     /*out*/ EVENT_ID_TYPE *EVENT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(EVENT_NAME) || !apex__out_ok(EVENT_ID, sizeof *EVENT_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(EVENT_NAME);
+    apex__check_out(EVENT_ID, sizeof *EVENT_ID);
     int k = apex__find_named(apex__intra.events, sizeof apex__intra.events[0],
                              apex__intra.n_events, EVENT_NAME);
     if (k < 0) {
@@ -140,13 +131,13 @@ void GET_EVENT_STATUS(
     /*out*/ EVENT_STATUS_TYPE *EVENT_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = event_index(EVENT_ID);
-    if (k < 0 || !apex__out_ok(EVENT_STATUS, sizeof *EVENT_STATUS)) {
+    if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
+    apex__check_out(EVENT_STATUS, sizeof *EVENT_STATUS);
     EVENT_STATUS->EVENT_STATE = apex__intra.events[k].state;
     EVENT_STATUS->WAITING_PROCESSES = apex__waiter_count(WAIT_EVT, k);
     *RETURN_CODE = NO_ERROR;

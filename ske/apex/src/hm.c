@@ -125,44 +125,48 @@ static void post_and_wait(hm_error_t err, hm_state_t st, const apex_proc_t *p,
         apex__yield_cpu();
 }
 
-/* An error of `failed` (NULL: the initialisation process) detected while in state `st`.
- * `fatal`: the failed context cannot go on (a fault signal); then this does not return. */
+/* An error of `failed` (NULL: the initialisation process) detected while in state `st`, after
+ * which it goes on: a missed deadline, an application error. */
 static void raise_error(apex_proc_t *failed, hm_state_t st, hm_error_t err, const char *msg,
-                        size_t len, uintptr_t address, bool fatal)
+                        size_t len)
 {
-    apex_rt_t *rt = &apex__rt;
-    if (decide(failed, st, err, fatal).level == HM_LEVEL_PROCESS) {
+    if (decide(failed, st, err, false).level == HM_LEVEL_PROCESS) {
         /* Process level: the error handler takes it (ARINC 653 Part 1, 2.4.2.3). */
-        enqueue(err, failed->id, address, msg, len);
+        enqueue(err, failed->id, 0, msg, len);
         trace_process_level(err, failed, msg, len);
         eh_activate();
-        if (fatal) {
-            /* The process cannot resume at the faulting instruction: it stops, and the
-             * handler may START it again. */
-            failed->state = DORMANT;
-            failed->wait = WAIT_NONE;
-            failed->wake_at = INT64_MAX;
-            if (rt->current == failed) {
-                rt->current = NULL;
-                setcontext(&rt->sched_ctx);
-            }
-        } else if (rt->current == failed) {
+        if (apex__rt.current == failed)
             apex__preempt_check(); /* the handler runs before the failed process goes on */
-        }
         return;
     }
     /* Partition or module level: the SKE decides again from its own copy of the tables. */
-    post_and_wait(err, st, failed, msg, len, fatal && !failed);
-    if (!fatal)
-        return;
+    post_and_wait(err, st, failed, msg, len, false);
+}
+
+/* An error after which the current context cannot go on (a fault signal, an address a
+ * service cannot use), detected in state `st`: it stops for good. At process level the error
+ * handler takes the error and may START the process again; otherwise the SKE decides. */
+static _Noreturn void fail_current(hm_state_t st, hm_error_t err, const char *msg, size_t len,
+                                   uintptr_t address)
+{
+    apex_rt_t *rt = &apex__rt;
+    apex_proc_t *failed = rt->current;
+    bool process_level = decide(failed, st, err, true).level == HM_LEVEL_PROCESS;
+    if (process_level) {
+        enqueue(err, failed->id, address, msg, len);
+        trace_process_level(err, failed, msg, len);
+        eh_activate();
+    } else {
+        post_and_wait(err, st, failed, msg, len, !failed);
+    }
     if (failed) {
         failed->state = DORMANT;
         failed->wait = WAIT_NONE;
         failed->wake_at = INT64_MAX;
-    }
-    if (rt->mode == NORMAL && rt->current && rt->current == failed) {
-        rt->current = NULL;
-        setcontext(&rt->sched_ctx);
+        if (process_level || rt->mode == NORMAL) {
+            rt->current = NULL;
+            setcontext(&rt->sched_ctx);
+        }
     }
     for (;;)
         apex__yield_cpu(); /* the initialisation or the scheduler itself failed */
@@ -221,15 +225,15 @@ static void on_fault(int sig, siginfo_t *si, void *uctx)
                      si->si_addr);
         break;
     }
-    raise_error(apex__rt.current, current_state(), err, msg, n > 0 ? (size_t)n : 0, addr, true);
+    fail_current(current_state(), err, msg, n > 0 ? (size_t)n : 0, addr);
 }
 
-void apex__invalid_address(const void *address)
+_Noreturn void apex__invalid_address(const void *address)
 {
     char msg[96];
     int n = snprintf(msg, sizeof msg, "APEX service given an invalid address (%p)", address);
-    raise_error(apex__rt.current, current_state(), HM_ERR_ILLEGAL_REQUEST, msg,
-                n > 0 ? (size_t)n : 0, (uintptr_t)address, true);
+    fail_current(current_state(), HM_ERR_ILLEGAL_REQUEST, msg, n > 0 ? (size_t)n : 0,
+                 (uintptr_t)address);
 }
 
 void apex__hm_init(void)
@@ -277,7 +281,7 @@ void apex__hm_check_deadlines(void)
         char msg[96];
         int n = snprintf(msg, sizeof msg, "deadline %lld ns passed at %lld ns",
                          (long long)p->deadline_time, (long long)now);
-        raise_error(p, HM_STATE_PROCESS, HM_ERR_DEADLINE_MISSED, msg, (size_t)n, 0, false);
+        raise_error(p, HM_STATE_PROCESS, HM_ERR_DEADLINE_MISSED, msg, (size_t)n);
     }
 }
 
@@ -289,8 +293,7 @@ void CREATE_ERROR_HANDLER(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     if (rt->has_eh) {
         *RETURN_CODE = NO_ACTION;
         return;
@@ -336,12 +339,8 @@ void GET_ERROR_STATUS(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__out_ok(ERROR_STATUS, sizeof *ERROR_STATUS)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_out(ERROR_STATUS, sizeof *ERROR_STATUS);
     if (!rt->has_eh || rt->current != &rt->eh) {
         *RETURN_CODE = INVALID_CONFIG; /* only the error handler may ask */
         return;
@@ -366,13 +365,13 @@ void RAISE_APPLICATION_ERROR(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (LENGTH < 0 || LENGTH > MAX_ERROR_MESSAGE_SIZE ||
-        (LENGTH > 0 && !apex__in_ok(MESSAGE_ADDR, (size_t)LENGTH))) {
+    apex__enter(RETURN_CODE);
+    if (LENGTH < 0 || LENGTH > MAX_ERROR_MESSAGE_SIZE) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
+    if (LENGTH > 0)
+        apex__check_in(MESSAGE_ADDR, (size_t)LENGTH);
     if (ERROR_CODE != APPLICATION_ERROR) {
         *RETURN_CODE = INVALID_PARAM;
         return;
@@ -381,5 +380,5 @@ void RAISE_APPLICATION_ERROR(
      * it, that is when this process runs again. */
     *RETURN_CODE = NO_ERROR;
     raise_error(rt->current, current_state(), HM_ERR_APPLICATION_ERROR, (const char *)MESSAGE_ADDR,
-                (size_t)LENGTH, 0, false);
+                (size_t)LENGTH);
 }

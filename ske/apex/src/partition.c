@@ -7,12 +7,8 @@ void GET_PARTITION_STATUS(
     /*out*/ PARTITION_STATUS_TYPE *PARTITION_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__out_ok(PARTITION_STATUS, sizeof *PARTITION_STATUS)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_out(PARTITION_STATUS, sizeof *PARTITION_STATUS);
     const ske_ctl_t *c = apex__rt.ctl;
     PARTITION_STATUS->PERIOD = c->period_ns;
     PARTITION_STATUS->DURATION = c->duration_ns;
@@ -29,8 +25,7 @@ void SET_PARTITION_MODE(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     if (OPERATING_MODE != IDLE && OPERATING_MODE != COLD_START && OPERATING_MODE != WARM_START &&
         OPERATING_MODE != NORMAL) {
         *RETURN_CODE = INVALID_PARAM;

@@ -84,13 +84,9 @@ void CREATE_PROCESS(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__in_ok(ATTRIBUTES, sizeof *ATTRIBUTES) ||
-        !apex__out_ok(PROCESS_ID, sizeof *PROCESS_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_in(ATTRIBUTES, sizeof *ATTRIBUTES);
+    apex__check_out(PROCESS_ID, sizeof *PROCESS_ID);
     const PROCESS_ATTRIBUTE_TYPE *a = ATTRIBUTES;
     if (rt->n_procs >= MAX_NUMBER_OF_PROCESSES) {
         *RETURN_CODE = INVALID_CONFIG;
@@ -164,8 +160,7 @@ void START(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     apex_proc_t *p = proc_by_id(PROCESS_ID);
     if (!p) {
         *RETURN_CODE = INVALID_PARAM;
@@ -219,12 +214,8 @@ void GET_MY_ID(
     /*out*/ PROCESS_ID_TYPE *PROCESS_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__out_ok(PROCESS_ID, sizeof *PROCESS_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_out(PROCESS_ID, sizeof *PROCESS_ID);
     if (!apex__rt.current || apex__rt.current == &apex__rt.eh) {
         *RETURN_CODE = INVALID_MODE; /* the initialisation process and the error handler */
         return;
@@ -238,12 +229,9 @@ void GET_PROCESS_ID(
     /*out*/ PROCESS_ID_TYPE *PROCESS_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(PROCESS_NAME) || !apex__out_ok(PROCESS_ID, sizeof *PROCESS_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(PROCESS_NAME);
+    apex__check_out(PROCESS_ID, sizeof *PROCESS_ID);
     for (int i = 0; i < apex__rt.n_procs; i++)
         if (same_name(apex__rt.procs[i].attr.NAME, PROCESS_NAME)) {
             *PROCESS_ID = apex__rt.procs[i].id;
@@ -258,13 +246,13 @@ void GET_PROCESS_STATUS(
     /*out*/ PROCESS_STATUS_TYPE *PROCESS_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     apex_proc_t *p = proc_by_id(PROCESS_ID);
-    if (!p || !apex__out_ok(PROCESS_STATUS, sizeof *PROCESS_STATUS)) {
+    if (!p) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
+    apex__check_out(PROCESS_STATUS, sizeof *PROCESS_STATUS);
     PROCESS_STATUS->ATTRIBUTES = p->attr;
     PROCESS_STATUS->CURRENT_PRIORITY = p->cur_prio;
     PROCESS_STATUS->DEADLINE_TIME = p->deadline_time;
@@ -298,8 +286,7 @@ void STOP(
     /*in */ PROCESS_ID_TYPE PROCESS_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     apex_proc_t *p = proc_by_id(PROCESS_ID);
     if (!p || p == apex__rt.current) {
         *RETURN_CODE = INVALID_PARAM; /* a process stops itself with STOP_SELF */
@@ -317,8 +304,7 @@ void SUSPEND_SELF(
     /*in */ SYSTEM_TIME_TYPE TIME_OUT,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     apex_proc_t *p = apex__rt.current;
     if (!apex__may_block()) {
         *RETURN_CODE = INVALID_MODE; /* preemption locked, error handler, initialisation */
@@ -349,8 +335,7 @@ void SUSPEND(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     apex_proc_t *p = proc_by_id(PROCESS_ID);
     if (!p || p == rt->current) {
         *RETURN_CODE = INVALID_PARAM; /* a process suspends itself with SUSPEND_SELF */
@@ -380,8 +365,7 @@ void RESUME(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     apex_proc_t *p = proc_by_id(PROCESS_ID);
     if (!p || p == rt->current) {
         *RETURN_CODE = INVALID_PARAM;
@@ -414,8 +398,7 @@ void SET_PRIORITY(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     apex_proc_t *p = proc_by_id(PROCESS_ID);
     if (!p || PRIORITY_VALUE < MIN_PRIORITY_VALUE || PRIORITY_VALUE > MAX_PRIORITY_VALUE) {
         *RETURN_CODE = INVALID_PARAM;
@@ -473,8 +456,7 @@ void DELAYED_START(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     apex_proc_t *p = proc_by_id(PROCESS_ID);
     if (!p) {
         *RETURN_CODE = INVALID_PARAM;
@@ -521,12 +503,8 @@ void LOCK_PREEMPTION(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__out_ok(LOCK_LEVEL, sizeof *LOCK_LEVEL)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_out(LOCK_LEVEL, sizeof *LOCK_LEVEL);
     if (!current_is_process() || rt->mode != NORMAL) {
         *RETURN_CODE = NO_ACTION;
         return;
@@ -546,12 +524,8 @@ void UNLOCK_PREEMPTION(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__out_ok(LOCK_LEVEL, sizeof *LOCK_LEVEL)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_out(LOCK_LEVEL, sizeof *LOCK_LEVEL);
     if (!current_is_process() || rt->mode != NORMAL || rt->lock_level == 0) {
         *RETURN_CODE = NO_ACTION;
         return;

@@ -121,13 +121,9 @@ void CREATE_QUEUING_PORT(
     /*out*/ QUEUING_PORT_ID_TYPE *QUEUING_PORT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(QUEUING_PORT_NAME) ||
-        !apex__out_ok(QUEUING_PORT_ID, sizeof *QUEUING_PORT_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(QUEUING_PORT_NAME);
+    apex__check_out(QUEUING_PORT_ID, sizeof *QUEUING_PORT_ID);
     int k = apex__port_by_name(QUEUING_PORT_NAME, SKE_PORT_QUEUING);
     if (k < 0) {
         *RETURN_CODE = INVALID_CONFIG;
@@ -169,8 +165,7 @@ void SEND_QUEUING_MESSAGE(
     /*in */ SYSTEM_TIME_TYPE TIME_OUT,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = apex__port_index(QUEUING_PORT_ID, SKE_PORT_QUEUING);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -182,7 +177,12 @@ void SEND_QUEUING_MESSAGE(
         return;
     }
     int64_t until = INT64_MAX;
-    if (LENGTH <= 0 || !apex__addr_ok(MESSAGE_ADDR) || TIME_OUT < INFINITE_TIME_VALUE ||
+    if (LENGTH <= 0) {
+        *RETURN_CODE = INVALID_PARAM;
+        return;
+    }
+    apex__check_addr(MESSAGE_ADDR);
+    if (TIME_OUT < INFINITE_TIME_VALUE ||
         (TIME_OUT > 0 && !apex__time_add(apex__now(), TIME_OUT, &until))) {
         *RETURN_CODE = INVALID_PARAM;
         return;
@@ -221,12 +221,9 @@ void RECEIVE_QUEUING_MESSAGE(
     /*out*/ MESSAGE_SIZE_TYPE *LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__addr_ok(MESSAGE_ADDR) || !apex__out_ok(LENGTH, sizeof *LENGTH)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_addr(MESSAGE_ADDR);
+    apex__check_out(LENGTH, sizeof *LENGTH);
     int k = apex__port_index(QUEUING_PORT_ID, SKE_PORT_QUEUING);
     int64_t until = INT64_MAX;
     if (k < 0 || TIME_OUT < INFINITE_TIME_VALUE ||
@@ -276,13 +273,9 @@ void GET_QUEUING_PORT_ID(
     /*out*/ QUEUING_PORT_ID_TYPE *QUEUING_PORT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(QUEUING_PORT_NAME) ||
-        !apex__out_ok(QUEUING_PORT_ID, sizeof *QUEUING_PORT_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(QUEUING_PORT_NAME);
+    apex__check_out(QUEUING_PORT_ID, sizeof *QUEUING_PORT_ID);
     int k = apex__port_by_name(QUEUING_PORT_NAME, SKE_PORT_QUEUING);
     if (k < 0 || !apex__rt.ports[k].created) {
         *RETURN_CODE = INVALID_CONFIG;
@@ -297,12 +290,8 @@ void GET_QUEUING_PORT_STATUS(
     /*out*/ QUEUING_PORT_STATUS_TYPE *QUEUING_PORT_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__out_ok(QUEUING_PORT_STATUS, sizeof *QUEUING_PORT_STATUS)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_out(QUEUING_PORT_STATUS, sizeof *QUEUING_PORT_STATUS);
     int k = apex__port_index(QUEUING_PORT_ID, SKE_PORT_QUEUING);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -321,8 +310,7 @@ void CLEAR_QUEUING_PORT(
     /*in */ QUEUING_PORT_ID_TYPE QUEUING_PORT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = apex__port_index(QUEUING_PORT_ID, SKE_PORT_QUEUING);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;

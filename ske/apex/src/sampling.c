@@ -39,13 +39,9 @@ void CREATE_SAMPLING_PORT(
     /*out*/ SAMPLING_PORT_ID_TYPE *SAMPLING_PORT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(SAMPLING_PORT_NAME) ||
-        !apex__out_ok(SAMPLING_PORT_ID, sizeof *SAMPLING_PORT_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(SAMPLING_PORT_NAME);
+    apex__check_out(SAMPLING_PORT_ID, sizeof *SAMPLING_PORT_ID);
     int k = apex__port_by_name(SAMPLING_PORT_NAME, SKE_PORT_SAMPLING);
     if (k < 0) {
         *RETURN_CODE = INVALID_CONFIG; /* no such port in the configuration */
@@ -81,8 +77,7 @@ void WRITE_SAMPLING_MESSAGE(
     /*in */ MESSAGE_SIZE_TYPE LENGTH,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = apex__port_index(SAMPLING_PORT_ID, SKE_PORT_SAMPLING);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -93,10 +88,11 @@ void WRITE_SAMPLING_MESSAGE(
         *RETURN_CODE = INVALID_CONFIG;
         return;
     }
-    if (LENGTH <= 0 || !apex__addr_ok(MESSAGE_ADDR)) {
+    if (LENGTH <= 0) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
+    apex__check_addr(MESSAGE_ADDR);
     if (d->dir != SKE_DIR_SOURCE) {
         *RETURN_CODE = INVALID_MODE;
         return;
@@ -119,13 +115,10 @@ void READ_SAMPLING_MESSAGE(
     /*out*/ VALIDITY_TYPE *VALIDITY,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__addr_ok(MESSAGE_ADDR) || !apex__out_ok(LENGTH, sizeof *LENGTH) ||
-        !apex__out_ok(VALIDITY, sizeof *VALIDITY)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_addr(MESSAGE_ADDR);
+    apex__check_out(LENGTH, sizeof *LENGTH);
+    apex__check_out(VALIDITY, sizeof *VALIDITY);
     int k = apex__port_index(SAMPLING_PORT_ID, SKE_PORT_SAMPLING);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -154,13 +147,9 @@ void GET_SAMPLING_PORT_ID(
     /*out*/ SAMPLING_PORT_ID_TYPE *SAMPLING_PORT_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(SAMPLING_PORT_NAME) ||
-        !apex__out_ok(SAMPLING_PORT_ID, sizeof *SAMPLING_PORT_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(SAMPLING_PORT_NAME);
+    apex__check_out(SAMPLING_PORT_ID, sizeof *SAMPLING_PORT_ID);
     int k = apex__port_by_name(SAMPLING_PORT_NAME, SKE_PORT_SAMPLING);
     if (k < 0 || !apex__rt.ports[k].created) {
         *RETURN_CODE = INVALID_CONFIG;
@@ -175,12 +164,8 @@ void GET_SAMPLING_PORT_STATUS(
     /*out*/ SAMPLING_PORT_STATUS_TYPE *SAMPLING_PORT_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__out_ok(SAMPLING_PORT_STATUS, sizeof *SAMPLING_PORT_STATUS)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_out(SAMPLING_PORT_STATUS, sizeof *SAMPLING_PORT_STATUS);
     int k = apex__port_index(SAMPLING_PORT_ID, SKE_PORT_SAMPLING);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;

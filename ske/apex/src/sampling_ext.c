@@ -33,13 +33,10 @@ void READ_UPDATED_SAMPLING_MESSAGE(
     /*out*/ UPDATED_TYPE *UPDATED,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__addr_ok(MESSAGE_ADDR) || !apex__out_ok(LENGTH, sizeof *LENGTH) ||
-        !apex__out_ok(UPDATED, sizeof *UPDATED)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_addr(MESSAGE_ADDR);
+    apex__check_out(LENGTH, sizeof *LENGTH);
+    apex__check_out(UPDATED, sizeof *UPDATED);
     int k = destination(SAMPLING_PORT_ID, RETURN_CODE);
     if (k < 0)
         return;
@@ -65,12 +62,8 @@ void GET_SAMPLING_PORT_CURRENT_STATUS(
     /*out*/ SAMPLING_PORT_CURRENT_STATUS_TYPE *SAMPLING_PORT_CURRENT_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__out_ok(SAMPLING_PORT_CURRENT_STATUS, sizeof *SAMPLING_PORT_CURRENT_STATUS)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_out(SAMPLING_PORT_CURRENT_STATUS, sizeof *SAMPLING_PORT_CURRENT_STATUS);
     int k = apex__port_index(SAMPLING_PORT_ID, SKE_PORT_SAMPLING);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -101,13 +94,10 @@ void READ_SAMPLING_MESSAGE_CONDITIONAL(
     /*out*/ SYSTEM_TIME_TYPE *TIME_STAMP,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__addr_ok(MESSAGE_ADDR) || !apex__out_ok(LENGTH, sizeof *LENGTH) ||
-        !apex__out_ok(TIME_STAMP, sizeof *TIME_STAMP)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_addr(MESSAGE_ADDR);
+    apex__check_out(LENGTH, sizeof *LENGTH);
+    apex__check_out(TIME_STAMP, sizeof *TIME_STAMP);
     int k = destination(SAMPLING_PORT_ID, RETURN_CODE);
     if (k < 0)
         return;

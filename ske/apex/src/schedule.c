@@ -20,8 +20,7 @@ void SET_MODULE_SCHEDULE(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     ske_ctl_t *c = apex__rt.ctl;
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     if (schedule_index(SCHEDULE_ID) < 0) {
         *RETURN_CODE = INVALID_PARAM; /* no such schedule */
         return;
@@ -40,12 +39,8 @@ void GET_MODULE_SCHEDULE_STATUS(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     const ske_ctl_t *c = apex__rt.ctl;
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__out_ok(SCHEDULE_STATUS, sizeof *SCHEDULE_STATUS)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_out(SCHEDULE_STATUS, sizeof *SCHEDULE_STATUS);
     SCHEDULE_STATUS->TIME_OF_LAST_SCHEDULE_SWITCH = atomic_load(&c->last_switch_ns);
     SCHEDULE_STATUS->CURRENT_SCHEDULE = atomic_load(&c->current_schedule);
     /* A request of ours the SKE has not taken yet is the next schedule already. */
@@ -61,12 +56,9 @@ void GET_MODULE_SCHEDULE_ID(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     const ske_ctl_t *c = apex__rt.ctl;
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(SCHEDULE_NAME) || !apex__out_ok(SCHEDULE_ID, sizeof *SCHEDULE_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(SCHEDULE_NAME);
+    apex__check_out(SCHEDULE_ID, sizeof *SCHEDULE_ID);
     size_t n = strnlen(SCHEDULE_NAME, MAX_NAME_LENGTH);
     for (uint32_t i = 0; i < c->n_schedules && i < SKE_SCHEDULES; i++)
         if (strnlen(c->schedule_names[i], SKE_NAME_MAX) == n &&

@@ -21,12 +21,9 @@ void CREATE_SEMAPHORE(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_intra_t *in = &apex__intra;
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(SEMAPHORE_NAME) || !apex__out_ok(SEMAPHORE_ID, sizeof *SEMAPHORE_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(SEMAPHORE_NAME);
+    apex__check_out(SEMAPHORE_ID, sizeof *SEMAPHORE_ID);
     if (in->n_semaphores >= MAX_NUMBER_OF_SEMAPHORES) {
         *RETURN_CODE = INVALID_CONFIG;
         return;
@@ -65,8 +62,7 @@ void WAIT_SEMAPHORE(
     /*in */ SYSTEM_TIME_TYPE TIME_OUT,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = semaphore_index(SEMAPHORE_ID);
     int64_t until;
     if (k < 0 || !apex__time_out(TIME_OUT, &until)) {
@@ -94,8 +90,7 @@ void SIGNAL_SEMAPHORE(
     /*in */ SEMAPHORE_ID_TYPE SEMAPHORE_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = semaphore_index(SEMAPHORE_ID);
     if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
@@ -122,12 +117,9 @@ void GET_SEMAPHORE_ID(
     /*out*/ SEMAPHORE_ID_TYPE *SEMAPHORE_ID,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__name_ok(SEMAPHORE_NAME) || !apex__out_ok(SEMAPHORE_ID, sizeof *SEMAPHORE_ID)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_name(SEMAPHORE_NAME);
+    apex__check_out(SEMAPHORE_ID, sizeof *SEMAPHORE_ID);
     int k = apex__find_named(apex__intra.semaphores, sizeof apex__intra.semaphores[0],
                              apex__intra.n_semaphores, SEMAPHORE_NAME);
     if (k < 0) {
@@ -143,13 +135,13 @@ void GET_SEMAPHORE_STATUS(
     /*out*/ SEMAPHORE_STATUS_TYPE *SEMAPHORE_STATUS,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     int k = semaphore_index(SEMAPHORE_ID);
-    if (k < 0 || !apex__out_ok(SEMAPHORE_STATUS, sizeof *SEMAPHORE_STATUS)) {
+    if (k < 0) {
         *RETURN_CODE = INVALID_PARAM;
         return;
     }
+    apex__check_out(SEMAPHORE_STATUS, sizeof *SEMAPHORE_STATUS);
     const apex_semaphore_t *s = &apex__intra.semaphores[k];
     SEMAPHORE_STATUS->CURRENT_VALUE = s->value;
     SEMAPHORE_STATUS->MAXIMUM_VALUE = s->max;

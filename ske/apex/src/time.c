@@ -8,8 +8,7 @@ void TIMED_WAIT(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     apex_proc_t *p = rt->current;
     if (!apex__may_block()) {
         *RETURN_CODE = INVALID_MODE; /* the initialisation process, the error handler */
@@ -35,8 +34,7 @@ void TIMED_WAIT(
 void PERIODIC_WAIT(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     apex_proc_t *p = apex__rt.current;
     if (!apex__may_block() || p->attr.PERIOD == INFINITE_TIME_VALUE) {
         *RETURN_CODE = INVALID_MODE;
@@ -52,12 +50,8 @@ void GET_TIME(
     /*out*/ SYSTEM_TIME_TYPE *SYSTEM_TIME,
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
-    if (!apex__enter(RETURN_CODE))
-        return;
-    if (!apex__out_ok(SYSTEM_TIME, sizeof *SYSTEM_TIME)) {
-        *RETURN_CODE = INVALID_PARAM;
-        return;
-    }
+    apex__enter(RETURN_CODE);
+    apex__check_out(SYSTEM_TIME, sizeof *SYSTEM_TIME);
     *SYSTEM_TIME = apex__now();
     *RETURN_CODE = NO_ERROR;
 }
@@ -67,8 +61,7 @@ void REPLENISH(
     /*out*/ RETURN_CODE_TYPE *RETURN_CODE)
 {
     apex_rt_t *rt = &apex__rt;
-    if (!apex__enter(RETURN_CODE))
-        return;
+    apex__enter(RETURN_CODE);
     apex_proc_t *p = rt->current;
     /* Nothing to replenish for the initialisation process, the error handler, or a process
      * with no time capacity (no deadline). */

@@ -21,6 +21,8 @@ static void usage(FILE *f)
           "  --lockstep-clients N     LOCKSTEP clients to wait for before T=0 (0: free-running)\n"
           "  --duration SECONDS | --end-ns NS   end of the run (none: until STOP or a signal)\n"
           "  --realtime               pace quanta by CLOCK_MONOTONIC\n"
+          "  --pace FACTOR            lockstep, but no faster than FACTOR x the wall clock\n"
+          "                           (a live view: the nodes' time stays emulated)\n"
           "  --trace FILE             JSON-lines trace ('-' for stdout)\n"
           "  --stats FILE             JSON statistics at exit ('-' for stdout)\n"
           "  --max-clients N          connected clients at most (64)\n"
@@ -78,7 +80,7 @@ static int parse_decl(const char *text, canbus_decl_t *d)
     if (!c1 || !c2 || c1 == text || (size_t)(c1 - text) >= CANBUS_NAME_LEN)
         return -1;
     memcpy(d->name, text, (size_t)(c1 - text));
-    for (const char *p = c1 + 1; p < c2;) {
+    for (const char *p = c1 + 1;; p++) { /* each role; an empty one is an error */
         size_t n = strcspn(p, "+:");
         if (n == 3 && strncmp(p, "can", 3) == 0)
             d->roles |= CANBUS_ROLE_CAN;
@@ -88,10 +90,12 @@ static int parse_decl(const char *text, canbus_decl_t *d)
             d->roles |= CANBUS_ROLE_OWN;
         else
             return -1;
-        p += n + (p[n] == '+');
+        p += n;
+        if (*p != '+')
+            break; /* at c2 */
     }
     int64_t node;
-    if (!d->roles || parse_i64(c2 + 1, 0, UINT32_MAX, &node))
+    if (parse_i64(c2 + 1, 0, UINT32_MAX, &node))
         return -1;
     d->node = (uint32_t)node;
     return 0;
@@ -110,7 +114,7 @@ int main(int argc, char **argv)
     enum {
         O_SOCKET = 256, O_BITRATE, O_QUANTUM, O_LOCKSTEP, O_DURATION, O_END, O_REALTIME,
         O_TRACE, O_STATS, O_MAXCL, O_FAULT, O_RECOVER, O_MAXREJ, O_SENDTO, O_CLBUF, O_GAP, O_KILL,
-        O_HANG, O_ORDER, O_CONTROL, O_DECL,
+        O_HANG, O_ORDER, O_CONTROL, O_DECL, O_PACE,
         O_HELP
     };
     static const struct option longopts[] = {
@@ -121,6 +125,7 @@ int main(int argc, char **argv)
         {"duration", required_argument, NULL, O_DURATION},
         {"end-ns", required_argument, NULL, O_END},
         {"realtime", no_argument, NULL, O_REALTIME},
+        {"pace", required_argument, NULL, O_PACE},
         {"trace", required_argument, NULL, O_TRACE},
         {"stats", required_argument, NULL, O_STATS},
         {"max-clients", required_argument, NULL, O_MAXCL},
@@ -185,6 +190,15 @@ int main(int argc, char **argv)
                 bad = "--end-ns must be >= 0";
             break;
         case O_REALTIME: o.realtime = true; break;
+        case O_PACE: {
+            char *end;
+            double d = strtod(optarg, &end);
+            if (end == optarg || *end || !(d > 0) || d > 1e6)
+                bad = "--pace must be a factor > 0 (emulated seconds per wall second)";
+            else
+                o.pace = d;
+            break;
+        }
         case O_CONTROL:
             if (parse_i64(optarg, 3, 1 << 20, &v))
                 bad = "--control-fd must be a descriptor number >= 3";
@@ -306,6 +320,11 @@ int main(int argc, char **argv)
             free_opts(&o);
             return EXIT_USAGE;
         }
+    }
+    if (o.realtime && o.pace > 0) {
+        fprintf(stderr, "ima-canbus: --realtime and --pace exclude each other\n");
+        free_opts(&o);
+        return EXIT_USAGE;
     }
     if (!o.socket_path || optind != argc) {
         usage(stderr);

@@ -42,6 +42,21 @@ def _bus(*args: str) -> subprocess.CompletedProcess:
     (["--send-timeout-ms", "0"], "--send-timeout-ms must be 1..3600000"),
     (["--client-buffer", "-1"], "--client-buffer must be >= 0"),
     (["--gap-bits", "1001"], "--gap-bits must be 0..1000"),
+    (["--duration", "1e10"], "--duration must be a number of seconds"),
+    (["--duration", "nan"], "--duration must be a number of seconds"),
+    (["--bitrate", "1x"], "--bitrate must be 1000..10000000"),
+    (["--bitrate", "99999999999999999999"], "--bitrate must be 1000..10000000"),
+    (["--control-fd", "2"], "--control-fd must be a descriptor number >= 3"),
+    (["--kill-node", "2@1e10"], "--kill-node must be NODE@SECONDS"),
+    (["--kill-node", "2@nan"], "--kill-node must be NODE@SECONDS"),
+    (["--kill-node", "2@5x"], "--kill-node must be NODE@SECONDS"),
+    (["--kill-node", "9" * 40 + "@5"], "--kill-node must be NODE@SECONDS"),
+    (["--pace", "0"], "--pace must be a factor > 0"),
+    (["--pace", "-2"], "--pace must be a factor > 0"),
+    (["--pace", "nan"], "--pace must be a factor > 0"),
+    (["--pace", "2x"], "--pace must be a factor > 0"),
+    (["--pace", "1e7"], "--pace must be a factor > 0"),
+    (["--pace", "2", "--realtime"], "--realtime and --pace exclude each other"),
     (["--no-such-option"], "usage: ima-canbus"),
     ([], "usage: ima-canbus"),  # no --socket
     (["extra"], "usage: ima-canbus"),
@@ -52,6 +67,35 @@ def test_a_bad_command_line_is_a_usage_error(tmp_path, args, says):
     assert p.returncode == 2, p.stderr
     assert says in p.stderr
     assert not sock.exists()
+
+
+@pytest.mark.parametrize("decl", [
+    "world",              # no roles, no node
+    "world:can",          # no node
+    ":can:0",             # no name
+    "x" * 33 + ":can:1",  # a name longer than the bus keeps
+    "world::0",           # no role
+    "world:can+:0",       # an empty role
+    "world:can+radio:0",  # no such role
+    "world:own+x:0",
+    "world:can:-1",       # a node number out of range
+    "world:can:4294967296",
+    "world:can:one",
+])
+def test_a_bad_client_declaration_is_a_usage_error(tmp_path, decl):
+    sock = tmp_path / "can.sock"
+    p = _bus("--socket", str(sock), "--client", decl)
+    assert p.returncode == 2, p.stderr
+    assert "--client must be NAME:ROLES:NODE" in p.stderr
+    assert not sock.exists()
+
+
+def test_every_role_is_declared(tmp_path):
+    """can, lockstep and own, in any order, joined by '+': the bus starts."""
+    sock = tmp_path / "can.sock"
+    p = _bus("--socket", str(sock), "--client", "w:own+lockstep+can:0", "--client",
+             "n1/io:can:1", "--duration", "0", "-q")
+    assert p.returncode == 0, p.stderr
 
 
 def test_help():

@@ -233,6 +233,11 @@ int canbus_bus_run(canbus_bus_t *b)
             if (b->release_late_ns > b->late_max_ns)
                 b->late_max_ns = b->release_late_ns;
             b->quanta_late += b->release_late_ns > 1000000;
+        } else if (b->o.pace > 0) {
+            /* Paced: quantum T is released no earlier than T / pace after the start. */
+            int64_t due = b->epoch_wall + (int64_t)((double)b->t / b->o.pace);
+            for (int64_t now; !b->stopping && (now = canbus__wall_ns()) < due;)
+                canbus__service(b, due - now);
         }
         wait_queues(b);
         if (b->stopping)

@@ -63,6 +63,7 @@ typedef struct canbus_opts {
     int lockstep_clients;
     int64_t end_ns; /* -1: none */
     bool realtime;
+    double pace; /* --pace: emulated seconds per wall second (0: as fast as possible) */
     int control_fd; /* --control-fd: the launcher's channel (FAULT, STOP), -1 for none */
     const char *trace_path;
     const char *stats_path;

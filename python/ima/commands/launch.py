@@ -19,6 +19,7 @@ from ima.launch import report as launch_report
 from ima.launch import run as launch_run
 from ima.launch import summary as launch_summary
 from ima.recording import recorder as recording
+from ima.websocket import launcher as live_server
 
 
 def positive_float(text: str) -> float:
@@ -58,6 +59,16 @@ def _wrong(text: str) -> tuple[str, str, float, float]:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def _port(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a port number: '{text}'") from None
+    if not 0 <= v <= 65535:
+        raise argparse.ArgumentTypeError(f"a port is 0..65535, not '{text}'")
+    return v
+
+
 def add_run_arguments(parser: argparse.ArgumentParser, kind: str = "launch") -> None:
     """The options of every run (`ima launch`, `ima fly`, `ima demo`)."""
     parser.add_argument("--duration", type=positive_float, default=600.0, metavar="SECONDS",
@@ -72,6 +83,15 @@ def add_run_arguments(parser: argparse.ArgumentParser, kind: str = "launch") -> 
                         help="mean wind speed, from 270° (default 10)")
     parser.add_argument("--realtime", action="store_true",
                         help="follow the wall clock instead of running as fast as possible")
+    parser.add_argument("--live", action="store_true",
+                        help="serve the run while it flies over the Foxglove WebSocket protocol "
+                        "on 127.0.0.1 (open ws://127.0.0.1:PORT in Foxglove), at real time "
+                        "unless --speed is given (docs/recording.md)")
+    parser.add_argument("--live-port", type=_port, default=8765, metavar="PORT",
+                        help="--live's port (default 8765; 0: any free port)")
+    parser.add_argument("--speed", type=positive_float, metavar="FACTOR",
+                        help="fly no faster than FACTOR emulated seconds per wall second, "
+                        "still in lockstep (default with --live: 1)")
     parser.add_argument("--run-dir", type=outdir.dir_arg, metavar="DIR",
                         help=f"where the traces go (default runs/{kind}-<date>-<time>-seed<N>)")
     parser.add_argument("--json", action="store_true",
@@ -149,7 +169,8 @@ def options_from(args: argparse.Namespace, system: Path | None = None,
         run_dir=args.run_dir, kind=kind, kill=list(args.kill_node), hang=list(args.hang_node),
         wrong_output=list(args.test_wrong_output), netns=args.netns, faults=faults_from(args),
         judge=not args.no_judge, golden=args.golden, test_switches=list(args.test_switch),
-        dds_security=args.dds_security)
+        dds_security=args.dds_security, live=args.live, live_port=args.live_port,
+        speed=args.speed)
 
 
 def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
@@ -169,6 +190,9 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
                         TextColumn("{task.completed:>6.0f}/{task.total:.0f} s"),
                         TimeRemainingColumn(), console=console)
     task = progress.add_task("flight", total=opts.duration_s)
+    if opts.realtime and opts.speed is not None:
+        raise ImaError("--speed paces a lockstep run; --realtime follows the wall clock: "
+                       "choose one", exit_code=2)
     if opts.run_dir is None:
         opts.run_dir = launch_options.new_run_dir(opts.kind, opts.seed)
     outdir.usable_dir(Path(opts.run_dir), "--run-dir")
@@ -181,13 +205,21 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
              for cls in ("node_crash", "node_freeze")}
     state = LiveState(Path(opts.run_dir), nodes, stops["node_crash"], hangs=stops["node_freeze"])
 
-    with Live(progress, console=console, transient=True, refresh_per_second=4) as live:
-        def on_status(st: dict) -> None:
-            state.update(st)
-            progress.update(task, completed=min(st.get("t_s", 0), opts.duration_s))
-            live.update(Group(state.render(), progress))
+    served = None
+    if opts.live:
+        served = live_server.start(Path(opts.run_dir).resolve(), nodes, opts.live_port)
+        console.print(f"live: [bold]{served[1]}[/] (Foxglove: Open connection, Foxglove "
+                      f"WebSocket), at {opts.speed or 1:g}x real time")
+    try:
+        with Live(progress, console=console, transient=True, refresh_per_second=4) as live:
+            def on_status(st: dict) -> None:
+                state.update(st)
+                progress.update(task, completed=min(st.get("t_s", 0), opts.duration_s))
+                live.update(Group(state.render(), progress))
 
-        result = launch_run.launch(opts, on_status=on_status)
+            result = launch_run.launch(opts, on_status=on_status)
+    finally:
+        served_counts = live_server.finish(served[0]) if served is not None else {}
     # the recording is made on the other CPU while we summarise
     recorder = recording.start(result.run_dir) if record else None
     summary = launch_summary.summarise(result.run_dir, pilot, opts.duration_s, result.nodes,
@@ -199,6 +231,9 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
     summary["interrupted_at_s"] = summary.get("flown_s") if result.interrupted else None
     summary["dds_domain"] = result.domain
     summary["provenance"] = provenance.provenance()
+    if served is not None:
+        summary["live_url"] = served[1]
+        summary.update(served_counts)
     launch_summary.write(result.run_dir, summary)
     if result.plan is not None:
         summary["faults"] = [{"id": f.fid, "spec": f.spec(), "class": f.cls,

@@ -63,6 +63,8 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
     bus += declared_clients(names, index)
     if opts.realtime:
         bus.append("--realtime")
+    elif opts.speed is not None or opts.live:
+        bus += ["--pace", f"{opts.speed or 1.0:g}"]
 
     world = [sys.executable, "-m", "imaworld", "--bus", str(sock), "--run-dir", str(run_dir),
              "--seed", str(opts.seed), "--pilot", str(pilot), "--turbulence", opts.turbulence,

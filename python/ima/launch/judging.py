@@ -14,10 +14,10 @@ from ima.launch.options import LaunchOptions, LaunchRun
 
 def golden_options(opts: LaunchOptions, run_dir: Path) -> LaunchOptions:
     """The run without its faults (nor the test-only switches that plant violations), into
-    run_dir, with the port hashes the oracles compare."""
+    run_dir, with the port hashes the oracles compare; as fast as it can go, not served."""
     return dataclasses.replace(opts, faults=[], kill=[], hang=[], wrong_output=[],
                                test_switches=[], run_dir=run_dir, judge=False, golden=None,
-                               port_hashes=True)
+                               port_hashes=True, speed=None, live=False)
 
 
 def fly_golden(opts: LaunchOptions, run_dir: Path) -> Path:

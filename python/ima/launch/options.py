@@ -31,6 +31,11 @@ class LaunchOptions:
     wind_kt: float = 10.0
     wind_from_deg: float = 270.0
     realtime: bool = False
+    # lockstep, but no faster than `speed` emulated seconds per wall second (None: as fast as
+    # possible; --live: 1)
+    speed: float | None = None
+    live: bool = False  # serve the run over the Foxglove WebSocket protocol (ima.websocket)
+    live_port: int = 8765
     run_dir: Path | None = None  # default: runs/<kind>-<date>-<time>-seed<N>
     kind: str = "launch"  # the run directory's prefix: launch, fly, demo
     kill: list[tuple[str, float]] = field(default_factory=list)  # (node, emulated s)

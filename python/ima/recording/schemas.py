@@ -72,3 +72,9 @@ def signals(name: str, fields: tuple[str, ...]) -> bytes:
     props = {"t_ns": {"type": "integer"}, "from": {"type": "string"}}
     props.update({f: {"type": "number"} for f in fields})
     return _obj(f"ima.can.{name}", props, f"The signals of CAN message {name} (DBC)")
+
+
+BUS_EVENT = event("ima.BusEvent", "The CAN bus's events: clients, faults, bus-off, stop")
+SKE_EVENT = event("ima.SkeEvent", "A node's SKE trace record (docs/trace-format.md)")
+DDS_EVENT = event("ima.DdsEvent", "A DDS agent's trace record (emulated t_ns, wall t_wall_ns)")
+WORLD_EVENT = event("ima.WorldEvent", "The world's events: actuators, votes, pilot, faults")

@@ -44,6 +44,13 @@ def _required(tmp_path: Path) -> list[str]:
     (["extra"], "unexpected argument extra"),
     (["--node", "3", "--nodes", "2"], "--node 3 is not one of --nodes 2"),
     (["--bind-device", "x" * 16], "--bind-device name too long"),
+    (["--node", "1x"], "--node wants 1..3"),
+    (["--node", ""], "--node wants 1..3"),
+    (["--domain", "99999999999999999999"], "--domain wants 0..232"),
+    (["--security", ""], "--security wants a directory"),
+    (["--security", "d" * 5000], "--security wants a directory"),
+    (["--ske-pid-fd", "2"], "--ske-pid-fd wants an open descriptor >= 3"),
+    (["--ske-pid-fd", "999"], "--ske-pid-fd wants an open descriptor >= 3"),
 ])
 def test_a_bad_command_line_is_a_usage_error(tmp_path, args, says):
     p = _agent(*_required(tmp_path), *args)
@@ -52,8 +59,11 @@ def test_a_bad_command_line_is_a_usage_error(tmp_path, args, says):
     assert p.stdout == ""
 
 
-def test_required_options_and_help(tmp_path):
-    p = _agent("--node", "1", "--nodes", "3")
+@pytest.mark.parametrize("missing", ["--node", "--nodes", "--socket", "--domain"])
+def test_required_options_and_help(tmp_path, missing):
+    args = _required(tmp_path)
+    del args[args.index(missing):args.index(missing) + 2]
+    p = _agent(*args)
     assert p.returncode == 2
     assert "--node, --nodes, --socket and --domain are required" in p.stderr
     p = _agent("--help")
@@ -64,9 +74,15 @@ def test_no_dds_configuration_is_refused(tmp_path):
     """Cyclone's default would send multicast on every interface."""
     p = _agent(*_required(tmp_path), config=None)
     assert p.returncode == 2 and "no Cyclone DDS configuration" in p.stderr
+    p = _agent(*_required(tmp_path), config="")
+    assert p.returncode == 2 and "no Cyclone DDS configuration" in p.stderr
     p = _agent(*_required(tmp_path), "--config", str(tmp_path / "missing.xml"))
     assert p.returncode == 1
     assert "cannot read the DDS configuration" in p.stderr
+    # a file:// URI names the same file
+    p = _agent(*_required(tmp_path), "--config", f"file://{tmp_path}/missing.xml")
+    assert p.returncode == 1
+    assert f"cannot read the DDS configuration {tmp_path}/missing.xml" in p.stderr
 
 
 def test_an_unwritable_trace_stops_the_agent(tmp_path):

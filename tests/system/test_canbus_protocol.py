@@ -9,6 +9,7 @@ import json
 import os
 import socket
 import subprocess
+import threading
 import time
 from pathlib import Path
 
@@ -25,7 +26,7 @@ def _connect(path: Path) -> socket.socket:
         try:
             s.connect(str(path))
             return s
-        except ConnectionRefusedError:
+        except (ConnectionRefusedError, FileNotFoundError):
             s.close()
             time.sleep(0.02)
     raise AssertionError(f"nobody listens at {path}")
@@ -130,3 +131,76 @@ def test_what_the_bus_refuses_and_rejects(tmp_path):
     assert [e["by"] for e in lines if e["kind"] == "stop_request"] == ["node1"]
     (frame,) = [e for e in lines if e["kind"] == "can_tx"]
     assert (frame["id"], frame["from"], frame["start_ns"]) == (0x123, "node1", 0), frame
+
+
+def test_a_client_that_stops_reading_is_queued_for_then_dropped(tmp_path):
+    """The bus never blocks on a client for long: what a listening client does not read is
+    queued, the quantum waits for it at most --send-timeout-ms, then the client is dropped
+    and the run goes on. A client that starts reading while the bus waits is served
+    everything, in order."""
+    sock, trace, stats = tmp_path / "can.sock", tmp_path / "can.jsonl", tmp_path / "can.json"
+    bus = subprocess.Popen([str(BUS), "--socket", str(sock), "--lockstep-clients", "1",
+                            "--client-buffer", "0", "--send-timeout-ms", "1000",
+                            "--trace", str(trace), "--stats", str(stats), "-q"],
+                           stderr=subprocess.PIPE, text=True)
+    clients = []
+    waiting_since = [None]  # when the lockstep client began to wait for its last tick
+    late_frames: list[int] = []
+    try:
+        node, _ = _join(sock, "node1", proto.ROLE_CAN | proto.ROLE_LOCKSTEP)
+        clients.append(node)
+        slow, _ = _join(sock, "slow", proto.ROLE_CAN)  # never reads
+        late, _ = _join(sock, "late", proto.ROLE_CAN)  # reads once the bus waits for it
+        clients += [slow, late]
+        for c in clients:
+            c.settimeout(20)
+
+        def read_late():
+            while True:
+                t = waiting_since[0]
+                if t is not None and time.monotonic() - t > 0.2:
+                    break
+                time.sleep(0.01)
+            while True:
+                data = late.recv(proto.MAX_DATAGRAM)
+                if not data:
+                    return
+                late_frames.extend(rec.id for rec in proto.unpack_recs(data)
+                                   if rec.type == proto.MSG_FRAME)
+
+        reader = threading.Thread(target=read_late, daemon=True)
+        reader.start()
+        payload = bytes(range(8))
+        t_next = _next_tick(node)
+        sent = 0
+        waited = False
+        while sent < 200000 and not waited:
+            node.send(proto.pack_frame(0x100 + sent % 0x400, payload, t_next, extended=False)
+                      + proto.pack_rec(proto.MSG_DONE, t_ns=t_next))
+            sent += 1
+            t0 = waiting_since[0] = time.monotonic()
+            t_next = _next_tick(node)
+            waiting_since[0] = None
+            waited = time.monotonic() - t0 > 0.5  # the bus waited for its slow listeners
+        assert waited, "the listening clients never filled their sockets"
+        for _ in range(50):  # the run goes on without `slow`
+            node.send(proto.pack_rec(proto.MSG_DONE, t_ns=t_next))
+            t_next = _next_tick(node)
+        node.send(proto.pack_rec(proto.MSG_STOP, id_=proto.STOP_REQUESTED))
+        assert bus.wait(timeout=30) == 0, bus.stderr.read()
+        reader.join(timeout=20)
+        assert not reader.is_alive()
+    finally:
+        for c in clients:
+            c.close()
+        if bus.poll() is None:
+            bus.kill()
+            bus.wait()
+        bus.stderr.close()
+    st = json.loads(stats.read_text())
+    assert st["send_timeouts"] == 1, st
+    leaves = [json.loads(line) for line in trace.read_text().splitlines()
+              if '"client_leave"' in line]
+    assert [(e["name"], e["reason"]) for e in leaves
+            if e["name"] in ("slow", "late")] == [("slow", "send_timeout")], leaves
+    assert late_frames == [0x100 + k % 0x400 for k in range(sent)]

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "ske/config.h"
+#include "ske__config.h"
 #include "ske_test.h"
 
 #ifndef IMA_SOURCE_DIR
@@ -701,6 +702,24 @@ static const bad_case_t bad_cases[] = {
      "<ima:Linux Executable=\"p2\" Arguments=\"a b c d e f g h i j k l m n o p q r s t u v w x y z "
      "A B C D E\"/>", NULL, NULL, "Executable=\"p2\"", "Linux", "at most 30 arguments",
      {"too many Arguments for partition 'p2'", NULL}},
+    /* start tags split over lines: the diagnostic names the line where the tag begins,
+     * whatever follows the element's name (a tab, a newline, CR LF) and with a prefix */
+    {"windows overlap, a tab after the name", "<Window_Schedule WindowIdentifier=\"2\" WindowStartSeconds=\"0.01\"",
+     "<Window_Schedule\tWindowIdentifier=\"2\"\n        WindowStartSeconds=\"0.005\"", NULL, NULL,
+     "<Window_Schedule\tWindowIdentifier=\"2\"", "Window_Schedule",
+     "windows of a module schedule do not overlap", {"overlaps window 1", NULL}},
+    {"windows overlap, a newline after the name", "<Window_Schedule WindowIdentifier=\"2\" WindowStartSeconds=\"0.01\"",
+     "<Window_Schedule\n        WindowIdentifier=\"2\" WindowStartSeconds=\"0.005\"", NULL, NULL,
+     "<Window_Schedule\n", "Window_Schedule",
+     "windows of a module schedule do not overlap", {"overlaps window 1", NULL}},
+    {"windows overlap, CR LF after the name", "<Window_Schedule WindowIdentifier=\"2\" WindowStartSeconds=\"0.01\"",
+     "<Window_Schedule\r\n        WindowIdentifier=\"2\" WindowStartSeconds=\"0.005\"", NULL, NULL,
+     "<Window_Schedule\r\n", "Window_Schedule",
+     "windows of a module schedule do not overlap", {"overlaps window 1", NULL}},
+    {"too many arguments, the tag over two lines", "<ima:Linux Executable=\"p2\"/>",
+     "<ima:Linux\n      Executable=\"p2\" Arguments=\"a b c d e f g h i j k l m n o p q r s t u v w x y z "
+     "A B C D E\"/>", NULL, NULL, "<ima:Linux\n", "Linux", "at most 30 arguments",
+     {"too many Arguments for partition 'p2'", NULL}},
     {"partition without a program", "<ima:Linux Executable=\"p2\"/>", "", NULL, NULL,
      "<Partition PartitionIdentifier=\"2\"", "Partition", "each Partition has an ima:Linux element",
      {"partition 'p2' does not say which program runs it", NULL}},
@@ -922,6 +941,25 @@ static void test_diag_format(void)
     CHECK_STR(small, "m.xml:1");
 }
 
+/* A diagnostic is one line: the control characters of what it quotes of the input become one
+ * space per run, none leads or trails; missing names become empty fields. */
+static void test_diag_set(void)
+{
+    ske_diag_t d;
+    ske__diag_set(&d, NULL, 3, NULL, NULL, "%s", "\n\tbad\r\n\x7fthing\n\n");
+    CHECK_STR(d.file, "?");
+    CHECK_STR(d.element, "");
+    CHECK_STR(d.rule, "");
+    CHECK_STR(d.message, "bad thing");
+    ske__diag_set(&d, "m.xml", 4, "Channel", "a rule", "%s", "\n\n");
+    CHECK_STR(d.message, "");
+    char buf[256];
+    d.element[0] = '\0';
+    ske__diag_set(&d, "m.xml", 4, NULL, "a rule", "%s", "no element");
+    ske_diag_format(&d, buf, sizeof buf);
+    CHECK_STR(buf, "m.xml:4: error: no element (rule: a rule)");
+}
+
 /* ---- regressions: defects found and fixed, checked on every run ------------------------ */
 
 /* A diagnostic names the line where the element starts. libxml2 records the line where the
@@ -1030,5 +1068,6 @@ int main(int argc, char **argv)
     RUN(test_limits);
     RUN(test_unreadable_inputs);
     RUN(test_diag_format);
+    RUN(test_diag_set);
     return ske_test_result();
 }

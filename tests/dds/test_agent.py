@@ -394,3 +394,84 @@ def test_c_client_through_two_agents(agents, run_dir):
         a.stop()
     # node1 took node2's inputs of the 35 rounds (warm-up included) as they came
     assert ags[0].read_stats()["dds_latency_us"]["count"] == 35
+
+
+def _raw_io(agent) -> socket.socket:
+    """A connection to the agent's io socket that has said HELLO and had its WELCOME."""
+    s = socket.socket(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+    s.settimeout(10)
+    s.connect(str(agent.socket))
+    s.send(xch.pack_hdr(xch.HELLO, agent.node))
+    assert len(s.recv(4096)) == xch.HDR.size  # WELCOME
+    return s
+
+
+def test_a_flood_of_bad_datagrams_is_traced_up_to_a_bound(agents):
+    (a,) = agents(1)
+    raw = socket.socket(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+    raw.connect(str(a.socket))
+    raw.send(xch.pack_hdr(xch.HELLO, 1) + b"\x00")  # a HELLO of the wrong size: link closed
+    raw.settimeout(10)
+    assert raw.recv(4096) == b""
+    raw.close()
+    raw = _raw_io(a)
+    for _ in range(1005):
+        raw.send(b"\x00" * 10)
+    raw.send(xch.pack_hdr(xch.INPUTS, 1) + inputs_for(1, 0, 0b1).pack())  # still served
+    assert xch.unpack_agreed(raw.recv(4096)).present == 0b1
+    raw.close()
+    a.stop()
+    assert a.read_stats()["bad_datagrams"] == 1006
+    traced = a.of_kind("bad_datagram")
+    assert len(traced) == 1000 and "more" in traced[-1] and "more" not in traced[-2]
+    assert [e["reason"] for e in a.of_kind("io_disconnect")] == ["bad_hello", "closed"]
+
+
+def test_a_second_io_waits_until_the_first_link_closes(agents):
+    """io restarted by its SKE while its old link is still open: the newcomer waits, and
+    becomes io once the old link is read to its end and closed."""
+    (a,) = agents(1)
+    first = _raw_io(a)
+    second = socket.socket(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+    second.settimeout(10)
+    second.connect(str(a.socket))
+    time.sleep(0.05)  # the agent has accepted it and keeps it waiting
+    first.send(xch.pack_hdr(xch.INPUTS, 1, 0) + inputs_for(1, 0, 0b1).pack())
+    assert xch.unpack_agreed(first.recv(4096)).present == 0b1  # the first is still io
+    first.close()
+    second.send(xch.pack_hdr(xch.HELLO, 1))
+    assert len(second.recv(4096)) == xch.HDR.size
+    second.send(xch.pack_hdr(xch.INPUTS, 1, 1) + inputs_for(1, 1, 0b1).pack())
+    assert xch.HDR.unpack_from(second.recv(4096))[4] == 1  # frame 1 answered
+    second.close()
+    a.stop()
+    assert a.read_stats()["io_connections"] == 2
+    assert [e["kind"] for e in a.events() if e["kind"].startswith("io_")] == [
+        "io_connect", "io_hello", "io_disconnect", "io_connect", "io_hello", "io_disconnect"]
+
+
+def test_inputs_asked_again_answer_the_old_frame_and_a_stalled_io_is_dropped(agents):
+    ags = agents(2)
+    raw = _raw_io(ags[0])
+    # node 2 says nothing: frame 0 waits; io asks for frame 1 before taking the answer
+    raw.send(xch.pack_hdr(xch.INPUTS, 1, 0) + inputs_for(1, 0, 0b11).pack())
+    time.sleep(0.05)
+    raw.send(xch.pack_hdr(xch.INPUTS, 1, 1) + inputs_for(1, 1, 0b1).pack())
+    first, second = raw.recv(4096), raw.recv(4096)
+    assert xch.HDR.unpack_from(first)[4] == 0 and xch.unpack_agreed(first).present == 0b01
+    assert xch.HDR.unpack_from(second)[4] == 1 and xch.unpack_agreed(second).present == 0b01
+    # an io that asks without ever reading the answers fills its socket: the link is dropped
+    raw.settimeout(None)
+    sent = 0
+    try:
+        for f in range(2, 20000):
+            raw.send(xch.pack_hdr(xch.INPUTS, 1, f) + inputs_for(1, f, 0b1).pack())
+            sent += 1
+    except OSError:
+        pass
+    raw.close()
+    ags[0].stop()
+    st = ags[0].read_stats()
+    assert st["superseded"] == 1, st
+    assert [e["reason"] for e in ags[0].of_kind("io_disconnect")] == ["io_not_reading"]
+    assert sent < 19998

@@ -7,7 +7,9 @@ import json
 import re
 import subprocess
 import sys
+import time
 import typing
+from collections import Counter
 from pathlib import Path
 
 from dds_helpers import inputs_for
@@ -81,3 +83,42 @@ def test_python_and_c_agents_exchange_inputs(agent_bin, run_dir, domain):
         if peer.poll() is None:
             peer.kill()
         a.stop()
+
+
+def test_writers_outside_a_node_partition_are_refused_and_listed(agent_bin, run_dir, domain):
+    """Without DDS Security, a participant may write in any partition: the agent takes a
+    sample's node from the one node partition its writer writes in, and refuses the sample
+    otherwise (another node's partition, two partitions, a wildcard). Refused writers are
+    listed while the table has room, counted always; the participant is reported."""
+    a = start_agent(1, 2, run_dir, domain, security="off", extra=["--startup-timeout-ms", "300"])
+    a.wait_ready()
+    writers = ["node2:1",          # node 2's partition, keyed as node 1
+               "node2,node1:2",    # two node partitions: no node
+               "node*:2",          # a wildcard matches every node's reader: no node
+               "node2:2",          # node 2's own: taken
+               "node2:1:62"]       # 62 more keyed as node 1: fill the agent's table of writers
+    forger = subprocess.Popen([sys.executable, str(HERE / "pyforger.py"), "--domain",
+                               str(domain), "--gone", "4",
+                               *(x for w in writers for x in ("--writer", w))],
+                              stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True, env=dds_env())
+    try:
+        assert forger.stdout.readline().strip() == "done", forger.stderr.read()
+        time.sleep(0.5)  # the last samples reach the agent
+        assert a.stop() == 0, a.stderr_text()
+    finally:
+        forger.stdin.close()
+        forger.wait(timeout=30)
+        forger.stderr.close()
+    st = a.read_stats()
+    # 65 refused; the table of 64 writers forgot the 4 gone ones, kept the taken one, and
+    # listed refusing writers until it was full: the last 2 are counted only
+    assert st["refused_samples"] == 65, st
+    refused = [(r["partition"], r["claimed_node"], r["samples"]) for r in st["refused"]]
+    assert len(refused) == 63
+    assert Counter(refused) == {("node2", 1, 1): 61, ("", 2, 1): 1, ("node*", 2, 1): 1}
+    assert st["topics"]["rpas_CrossChannelInputs"]["read"] >= 5, st["topics"]  # the gone 4 and node2:2
+    (p,) = st["foreign_participants"]
+    assert p["refused"] and p["pid"] == forger.pid, p
+    traced = [(e["partition"], e["claimed_node"]) for e in a.of_kind("dds_refused")]
+    assert Counter(traced) == {("node2", 1): 61, ("", 2): 1, ("node*", 2): 1}

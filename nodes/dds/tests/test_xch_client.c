@@ -72,7 +72,7 @@ static int child(const char *path)
     rc = xch_client_exchange(&c, 7, 350000000, &mine, &g);
     if (rc != 0 || g.present != 0x3 || g.in[0].gps_seq != 99 || g.in[1].gps[0] != 47.25)
         return 13;
-    if (c.stale != 1 || c.rejected != 1)
+    if (c.stale != 1 || c.rejected != 5)
         return 14;
     struct xch_health h = {.membership = 7, .fcs_mode = 2};
     struct xch_telemetry t = {.fcs_mode = 2, .lat_deg = 1.5};
@@ -82,7 +82,11 @@ static int child(const char *path)
         xch_client_send(&c, XCH_MISSION, 7, 350000000, &m, sizeof m) != 0)
         return 15;
     if (xch_client_send(&c, XCH_HEALTH, 7, 0, &h, sizeof h - 1) != -EINVAL ||
-        xch_client_send(&c, XCH_AGREED, 7, 0, &g, sizeof g) != -EINVAL)
+        xch_client_send(&c, XCH_AGREED, 7, 0, &g, sizeof g) != -EINVAL ||
+        xch_client_send(&c, XCH_HELLO, 7, 0, NULL, 0) != -EINVAL ||
+        xch_client_send(&c, XCH_WELCOME, 7, 0, NULL, 0) != -EINVAL ||
+        xch_client_send(&c, XCH_HEALTH, 7, 0, NULL, sizeof h) != -EINVAL ||
+        xch_client_send(&c, 999, 7, 0, &h, sizeof h) != -EINVAL)
         return 16;
     /* nothing comes for frame 8: the wait ends by its timeout */
     if (xch_client_await(&c, 8, &g, 50) != -ETIMEDOUT)
@@ -140,8 +144,20 @@ static void agent(int lfd)
     struct xch_agreed g;
     memset(&g, 0, sizeof g);
     send_agreed(fd, 2, 6, &g); /* an old frame's answer: skipped */
+    /* rejected: not an answer (a welcome; short; another node's; wrong magic or version) */
     struct xch_hdr junk = {XCH_MAGIC, XCH_VERSION, XCH_WELCOME, 2, 3, 0};
-    CHECK(send(fd, &junk, sizeof junk, 0) == (ssize_t)sizeof junk); /* rejected */
+    CHECK(send(fd, &junk, sizeof junk, 0) == (ssize_t)sizeof junk);
+    junk.type = XCH_AGREED;
+    CHECK(send(fd, &junk, sizeof junk, 0) == (ssize_t)sizeof junk);
+    struct {
+        struct xch_hdr h;
+        struct xch_agreed g;
+    } wrong[] = {{{XCH_MAGIC, XCH_VERSION, XCH_AGREED, 1, 7, 0}, g},
+                 {{XCH_MAGIC ^ 1, XCH_VERSION, XCH_AGREED, 2, 7, 0}, g},
+                 {{XCH_MAGIC, XCH_VERSION + 1, XCH_AGREED, 2, 7, 0}, g}};
+    CHECK(send(fd, wrong, sizeof wrong[0], 0) == (ssize_t)sizeof wrong[0]);
+    CHECK(send(fd, wrong + 1, sizeof wrong[0], 0) == (ssize_t)sizeof wrong[0]);
+    CHECK(send(fd, wrong + 2, sizeof wrong[0], 0) == (ssize_t)sizeof wrong[0]);
     g.present = 0x3;
     g.in[0].gps_seq = 99;
     g.in[1] = p.in;
@@ -222,10 +238,24 @@ static void test_joins_that_fail(const char *path)
     pid = bad_agent(path, &other, sizeof other);
     check_refused(path, 2, -EPROTO, "did not answer with a welcome for node 2");
     waitpid(pid, NULL, 0);
-    struct xch_hdr no_nodes = {XCH_MAGIC, XCH_VERSION, XCH_WELCOME, 2, 0, 0};
-    pid = bad_agent(path, &no_nodes, sizeof no_nodes);
-    check_refused(path, 2, -EPROTO, "did not answer with a welcome");
-    waitpid(pid, NULL, 0);
+    /* each field of the welcome wrong in turn: node counts 0 and 33, magic, version, type,
+     * and a datagram longer than a welcome */
+    struct {
+        struct xch_hdr h;
+        uint32_t extra;
+    } bad[] = {
+        {{XCH_MAGIC, XCH_VERSION, XCH_WELCOME, 2, 0, 0}, 0},
+        {{XCH_MAGIC, XCH_VERSION, XCH_WELCOME, 2, XCH_MAX_NODES + 1, 0}, 0},
+        {{XCH_MAGIC ^ 1, XCH_VERSION, XCH_WELCOME, 2, 3, 0}, 0},
+        {{XCH_MAGIC, XCH_VERSION + 1, XCH_WELCOME, 2, 3, 0}, 0},
+        {{XCH_MAGIC, XCH_VERSION, XCH_HEALTH, 2, 3, 0}, 0},
+        {{XCH_MAGIC, XCH_VERSION, XCH_WELCOME, 2, 3, 0}, 1},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        pid = bad_agent(path, &bad[i], sizeof bad[i].h + (bad[i].extra ? sizeof bad[i].extra : 0));
+        check_refused(path, 2, -EPROTO, "did not answer with a welcome");
+        waitpid(pid, NULL, 0);
+    }
 
     /* Not connected: nothing to send on or wait for. */
     xch_client_t c;

@@ -111,6 +111,43 @@ def messages(path: Path, topics: list[str]) -> Iterator[tuple[str, int, bytes]]:
                     yield topic, pairs[k - 1], records[off + 9 + 22:off + 9 + ln]
 
 
+def chunks(path: Path, topics: list[str]) -> Iterator[tuple[bytes, int]] | None:
+    """(decompressed records, number of messages of `topics` in them) of every chunk holding
+    a message of `topics`, in file order, for a reader that scans a chunk's bytes whole; None
+    if the file has no summary to say which (the caller then reads message by message)."""
+    with open(path, "rb") as f:
+        if f.read(len(MAGIC)) != MAGIC:
+            raise ValueError("not an MCAP file")
+        s = _summary(f)
+    if s is None or any(c[3] not in ("", "zstd") for c in s[1]):
+        return None
+    channels, index = s
+    want = {cid for cid, t in channels.items() if t in topics}
+    return _chunk_records(path, [c for c in index if want & c[2].keys()], want)
+
+
+def _chunk_records(path: Path, index, want: set[int]) -> Iterator[tuple[bytes, int]]:
+    import zstandard
+
+    dctx = zstandard.ZstdDecompressor()
+    with open(path, "rb") as f:
+        for start, length, idx, _ in index:
+            count = 0
+            for cid in want & idx.keys():  # each message index: (time, offset) pairs
+                f.seek(idx[cid] + 9 + 2)
+                count += _U32.unpack(f.read(4))[0] // 16
+            f.seek(start)
+            chunk = f.read(length)
+            if chunk[0] != OP_CHUNK:
+                raise ValueError(f"no chunk at {start}")
+            raw_size = _U64.unpack_from(chunk, 9 + 16)[0]
+            comp_name, p = _string(chunk, 9 + 28)
+            n = _U64.unpack_from(chunk, p)[0]
+            data = chunk[p + 8:p + 8 + n]
+            records = dctx.decompress(data, max_output_size=raw_size) if comp_name else data
+            yield records, count
+
+
 def _fallback(path: Path, topics: list[str]):
     from mcap.reader import make_reader
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ima.trace import bits
+from ima.trace.columns import Columns
 from ima.trace.source import Trace
 
 DEFAULT_WINDOW_S = 1.0
@@ -55,24 +56,23 @@ def _message(dbc, can_id: int, extended: bool):
     return msg if bool(msg.is_extended_frame) == extended else None
 
 
-def compute(trace: Trace, dbc=None, window_s: float = DEFAULT_WINDOW_S,
+def compute(trace: Trace | Columns, dbc=None, window_s: float = DEFAULT_WINDOW_S,
             bitrate: int | None = None) -> dict:
     """The statistics of a trace (see the module's doc for each figure)."""
-    rate = bitrate or trace.bitrate or DEFAULT_BITRATE
-    win_ns = max(1, round(window_s * 1e9))
     import numpy as np
 
-    data = [f for f in trace.frames if not f.error]
-    n_errors = len(trace.frames) - len(data)
-    end_ns = max(trace.duration_ns or 0, data[-1].t_ns if data else 0)
+    from ima.trace import columns
+
+    c = trace if isinstance(trace, Columns) else columns.of_trace(trace)
+    rate = bitrate or c.bitrate or DEFAULT_BITRATE
+    win_ns = max(1, round(window_s * 1e9))
+    ok = ~c.error
+    n_errors = int(np.count_nonzero(c.error))
+    t, ids_, ext, rtr, dlen = c.t_ns[ok], c.id[ok], c.ext[ok], c.rtr[ok], c.dlen[ok]
+    n = len(t)
+    end_ns = max(c.duration_ns or 0, int(t[-1]) if n else 0)
     n_win = max(1, -(-end_ns // win_ns))
-    n = len(data)
-    t = np.fromiter((f.t_ns for f in data), dtype=np.int64, count=n)
-    ids_ = np.fromiter((f.id for f in data), dtype=np.int64, count=n)
-    ext = np.fromiter((f.extended for f in data), dtype=bool, count=n)
-    rtr = np.fromiter((f.remote for f in data), dtype=bool, count=n)
-    exact_bits = bits.frame_bits_many(ids_, ext, rtr, [f.data for f in data])
-    dlen = np.fromiter((0 if f.remote else len(f.data) for f in data), dtype=np.int64, count=n)
+    exact_bits = bits.frame_bits_columns(ids_, ext, rtr, dlen, c.data[ok])
     g = np.where(ext, 54, 34)
     worst_bits = g + 8 * dlen + 13 + (g + 8 * dlen - 1) // 4  # bits.worst_case_bits
     w = np.minimum(t // win_ns, n_win - 1)
@@ -97,12 +97,12 @@ def compute(trace: Trace, dbc=None, window_s: float = DEFAULT_WINDOW_S,
         ids.append(_id_stats(can_id, is_ext, np.sort(t[order[a:b]]),
                              _message(dbc, can_id, is_ext)))
     return {
-        "source": trace.source,
-        "frames": len(data),
+        "source": c.source,
+        "frames": n,
         "error_frames": n_errors,
         "duration_s": _r(end_ns / 1e9),
         "bitrate": rate,
-        "bitrate_known": bool(bitrate or trace.bitrate),
+        "bitrate_known": bool(bitrate or c.bitrate),
         "window_s": window_s,
         "bus_load": _r(float(exact.sum()) / (rate * total_s), 4),
         "bus_load_worst_case": _r(float(worst.sum()) / (rate * total_s), 4),
@@ -111,7 +111,7 @@ def compute(trace: Trace, dbc=None, window_s: float = DEFAULT_WINDOW_S,
         "ids": ids,
         "deadline_misses": sum(i["deadline_misses"] for i in ids),
         "gaps": sum(i["gaps"] for i in ids),
-        "bus_off": trace.bus_off,
+        "bus_off": c.bus_off,
     }
 
 
@@ -165,13 +165,13 @@ def run(args) -> int:
     import math
 
     from ima.errors import ImaError
-    from ima.trace import source
+    from ima.trace import columns
 
     if not (math.isfinite(args.window) and args.window > 0):
         raise ImaError("--window must be a positive number of seconds", exit_code=2)
     if args.bitrate is not None and args.bitrate <= 0:
         raise ImaError("--bitrate must be positive", exit_code=2)
-    trace = source.load(args.input)
+    trace = columns.load(args.input)
     result = compute(trace, load_dbc(args.dbc), args.window, args.bitrate)
     if args.plot:
         plot(result, args.plot)

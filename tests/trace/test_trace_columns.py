@@ -10,8 +10,9 @@ import json
 import numpy as np
 import pytest
 
+from ima.errors import ImaError
 from ima.recording import write
-from ima.trace import columns, export, source, stats
+from ima.trace import asc, blf, columns, export, source, stats
 
 
 def _bus_lines(n: int, odd_line: bool = False) -> list[str]:
@@ -83,3 +84,32 @@ def test_a_python_can_log_gives_the_frames_source_reads(tmp_path, fmt):
     export.export(source.load(tmp_path).frames, fmt, log)
     _same(columns.load(log), columns.of_trace(source.load(log)))
     assert stats.compute(columns.load(log)) == stats.compute(source.load(log))
+
+
+def test_logs_our_readers_do_not_know_are_read_by_python_can(tmp_path):
+    (tmp_path / "can.jsonl").write_text("\n".join(_bus_lines(300)) + "\n")
+    frames = source.load(tmp_path).frames
+    log = tmp_path / "bus.asc"
+    export.export(frames, "asc", log)
+    text = log.read_text()
+    assert asc.read(log) is not None
+    dec = tmp_path / "dec.asc"
+    dec.write_text(text.replace("base hex", "base dec"))  # hex digits in decimal: unreadable
+    assert asc.read(dec) is None
+    for load in (columns.load, source.load):
+        with pytest.raises(ImaError, match="python-can cannot read it"):
+            load(dec)
+    odd = {"relative.asc": text.replace("timestamps absolute", "timestamps relative"),
+           "attributes.asc": text.replace(" Rx   d 8 ", " Rx   d 8 ", 1).replace(
+               "\n", "  Length = 224000 BitCount = 135\n", 7)}
+    for name, body in odd.items():
+        path = tmp_path / name
+        path.write_text(body)
+        assert asc.read(path) is None, name
+        _same(columns.load(path), columns.of_trace(source.load(path)))
+    blf_log = tmp_path / "bus.blf"
+    export.export(frames, "blf", blf_log)
+    cut = tmp_path / "cut.blf"
+    cut.write_bytes(blf_log.read_bytes()[:-40])  # a log whose writer was killed
+    assert blf.read(cut) is None
+    _same(columns.load(cut), columns.of_trace(source.load(cut)))

@@ -137,3 +137,18 @@ def test_an_unreadable_log_is_an_error(tmp_path):
     bad.write_bytes(b"not a blf")
     with pytest.raises(ImaError):
         source.load(bad)
+
+
+def test_many_frames_at_once_have_the_lengths_of_each_alone():
+    r = random.Random(5)
+    frames = []
+    for _ in range(3000):
+        ext, remote = r.random() < 0.5, r.random() < 0.1
+        n = r.randint(0, 8)
+        data = b"" if remote else bytes(r.choice((0, 0xFF, 0x0F, 0xF0, r.getrandbits(8)))
+                                        for _ in range(n))
+        frames.append((r.choice((0, (1 << (29 if ext else 11)) - 1, r.getrandbits(
+            29 if ext else 11))), ext, remote, data))
+    many = bits.frame_bits_many([f[0] for f in frames], [f[1] for f in frames],
+                                [f[2] for f in frames], [f[3] for f in frames])
+    assert list(many) == [bits.frame_bits(i, e, d, rt) for i, e, rt, d in frames]

@@ -210,6 +210,8 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
         served = live_server.start(Path(opts.run_dir).resolve(), nodes, opts.live_port)
         console.print(f"live: [bold]{served[1]}[/] (Foxglove: Open connection, Foxglove "
                       f"WebSocket), at {opts.speed or 1:g}x real time")
+    # the recording follows the traces while the run flies (on the CPU the lockstep leaves)
+    recorder = recording.start(Path(opts.run_dir), nodes) if record else None
     try:
         with Live(progress, console=console, transient=True, refresh_per_second=4) as live:
             def on_status(st: dict) -> None:
@@ -218,10 +220,12 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
                 live.update(Group(state.render(), progress))
 
             result = launch_run.launch(opts, on_status=on_status)
+    except BaseException:
+        recording.abandon(recorder)
+        raise
     finally:
         served_counts = live_server.finish(served[0]) if served is not None else {}
-    # the recording is made on the other CPU while we summarise
-    recorder = recording.start(result.run_dir) if record else None
+    recording.flown(recorder)  # it reads what is left while we summarise
     summary = launch_summary.summarise(result.run_dir, pilot, opts.duration_s, result.nodes,
                                        result.killed, result.wall_s, plot=True,
                                        hung=result.hung)

@@ -1,15 +1,21 @@
 # SPDX-License-Identifier: Apache-2.0
-"""python -m ima.recording RUN_DIR [--wait-summary]: writes RUN_DIR/run.mcap.
+"""python -m ima.recording RUN_DIR [--wait-summary] [--follow --nodes A,B]: writes
+RUN_DIR/run.mcap. Prints its counts as JSON.
 
-With --wait-summary (the launcher's way: it starts the recorder as soon as the run's
-processes have ended, so that the recording is made on the other CPU while the summary is
-judged and plotted) the traces are converted at once, then the recorder waits for its
-standard input to close and adds the summary's verdicts. Prints its counts as JSON."""
+The launcher's way (recorder.py): with --follow it starts with the run and follows its traces
+as they grow, on the CPU the lockstep leaves idle, until a line `ended` on its standard input
+says the run's processes have ended; it then reads what is left. With --wait-summary it then
+waits for its standard input to close (the summary is final) and adds the summary's
+verdicts. Ctrl-C is the launcher's to handle: a following recorder ignores it and records the
+run up to its stop."""
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import select
+import signal
 import sys
 from pathlib import Path
 
@@ -17,18 +23,53 @@ from ima.errors import ImaError
 from ima.recording import write
 
 
+class _Stdin:
+    """The launcher's word: `ended` (the traces are complete), then end of file (the summary
+    is final). End of file alone says both (the launcher has gone)."""
+
+    def __init__(self) -> None:
+        self.fd = sys.stdin.fileno()
+        self.ended = self.closed = False
+
+    def _read(self, timeout: float | None) -> None:
+        ready, _, _ = select.select([self.fd], [], [], timeout)
+        if ready:
+            data = os.read(self.fd, 4096)
+            if not data:
+                self.ended = self.closed = True
+            elif b"ended" in data:
+                self.ended = True
+
+    def run_ended(self) -> bool:
+        if not self.ended:
+            self._read(0)
+        return self.ended
+
+    def wait_closed(self) -> None:
+        while not self.closed:
+            self._read(None)
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m ima.recording")
     p.add_argument("run_dir", type=Path)
     p.add_argument("--wait-summary", action="store_true")
+    p.add_argument("--follow", action="store_true")
+    p.add_argument("--nodes", help="the run's nodes, comma-separated (with --follow)")
     args = p.parse_args(argv)
+    stdin = _Stdin()
+    if args.follow:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        os.nice(10)  # the flight first
 
     def wait() -> None:
         if args.wait_summary:
-            sys.stdin.read()  # EOF: summary.json is final
+            stdin.wait_closed()
 
     try:
-        counts = write.record(args.run_dir, before_verdicts=wait)
+        counts = write.record(args.run_dir, before_verdicts=wait,
+                              follow=stdin.run_ended if args.follow else None,
+                              nodes=args.nodes.split(",") if args.nodes else None)
     except ImaError as e:
         print(f"ima: recording: {e}", file=sys.stderr)
         return 1

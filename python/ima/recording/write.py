@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """RUN_DIR/run.mcap from the traces a run leaves (docs/recording.md).
 
-The recording is made from the producers' own traces once the run has ended (after Ctrl-C
-as well: every trace is complete up to the stop), or from whatever a killed run left
-(`ima trace recover`): a line cut by the kill is skipped and counted. Each message's log
+The recording is made from the producers' own traces: while the run flies, following them as
+they grow (the launcher's way), or once it has ended, or from whatever a killed run left
+(`ima trace recover`). After Ctrl-C every trace is complete up to the stop; a line cut by a
+kill is skipped and counted. Each message's log
 time is the record's emulated time (t_ns); its sequence number is the record's number (its
 line, from 0) in its producer's trace, so a reader can check that nothing was dropped. The
 file is written beside as run.mcap.part and renamed when complete.
@@ -13,16 +14,19 @@ from __future__ import annotations
 
 import json
 import os
+import time
 from pathlib import Path
 
 import orjson
 
 from ima.errors import ImaError
 from ima.recording import schemas
+from ima.recording.follow import Follow
 from ima.recording.topics import Topics
 
 NAME = "run.mcap"
 CHUNK_BYTES = 1 << 20
+POLL_S = 0.05  # how often a followed run's traces are read
 
 
 class _Out:
@@ -115,36 +119,44 @@ def _metadata(out: _Out, run_dir: Path, launch: dict) -> None:
     out.w.metadata("ima.run", meta)
 
 
-def record(run_dir: Path, output: Path | None = None, before_verdicts=None) -> dict:
+def record(run_dir: Path, output: Path | None = None, before_verdicts=None,
+           follow=None, nodes: list[str] | None = None) -> dict:
     """Writes the recording of run_dir; returns its counts: messages per topic, lines skipped
     (cut by a kill). `before_verdicts()` is called once the traces are in, before the
-    summary's verdicts are read (the launcher's recorder waits there for the summary)."""
+    summary's verdicts are read (the launcher's recorder waits there for the summary).
+
+    With `follow`, the run is still flying: the traces are followed as they grow, every
+    POLL_S, until `follow()` says the run's processes have ended (the launcher's recorder:
+    the recording is made on the CPU the lockstep leaves idle); `nodes` then names the run's
+    nodes (launch.json may not exist yet)."""
     run_dir = Path(run_dir)
-    if not (run_dir / "can.jsonl").exists() and not (run_dir / "truth.jsonl").exists():
+    if follow is None and not (run_dir / "can.jsonl").exists() and not (
+            run_dir / "truth.jsonl").exists():
         raise ImaError(f"{run_dir}: not a run directory (no can.jsonl, no truth.jsonl)")
     output = Path(output) if output else run_dir / NAME
-    try:
-        launch = json.loads((run_dir / "launch.json").read_text())
-    except (OSError, ValueError):
-        launch = {}
-    nodes = list(launch.get("nodes") or sorted(
-        p.stem for p in run_dir.glob("node*.jsonl") if p.stem[4:].isdigit()))
     part = output.with_name(output.name + ".part")
     try:
         with open(part, "w+b") as f:
             out = _Out(f)
-            _metadata(out, run_dir, launch)
             topics = Topics(out)
-            topics.can(_numbered(run_dir / "can.jsonl"))
-            for k, node in enumerate(nodes, start=1):
-                topics.ske(node, _numbered(run_dir / f"{node}.jsonl"))
-                topics.dds(node, f"dds{k}.jsonl", _numbered(run_dir / f"dds{k}.jsonl"))
+            if follow is not None:
+                _follow(topics, run_dir, list(nodes or []), follow)
+            launch = _launch(run_dir)
+            nodes = list(nodes or launch.get("nodes") or sorted(
+                p.stem for p in run_dir.glob("node*.jsonl") if p.stem[4:].isdigit()))
+            if follow is None:
+                topics.can(_numbered(run_dir / "can.jsonl"))
+                for k, node in enumerate(nodes, start=1):
+                    topics.ske(node, _numbered(run_dir / f"{node}.jsonl"))
+                    topics.dds(node, f"dds{k}.jsonl", _numbered(run_dir / f"dds{k}.jsonl"))
+                topics.world(_numbered(run_dir / "world.jsonl"))
+                topics.truth(_numbered(run_dir / "truth.jsonl"))
+            for node in nodes:
                 _fdr(out, run_dir, node)
-            topics.world(_numbered(run_dir / "world.jsonl"))
-            topics.truth(_numbered(run_dir / "truth.jsonl"))
             if before_verdicts is not None:
                 before_verdicts()
             _verdicts(out, run_dir, launch)
+            _metadata(out, run_dir, launch)
             out.w.finish()
         os.replace(part, output)
     except OSError as e:
@@ -152,3 +164,29 @@ def record(run_dir: Path, output: Path | None = None, before_verdicts=None) -> d
         raise ImaError(f"{output}: cannot write the recording: {e.strerror}") from e
     return {"file": str(output), "bytes": output.stat().st_size, "topics": out.counts,
             "skipped_lines": topics.skipped}
+
+
+def _launch(run_dir: Path) -> dict:
+    try:
+        return json.loads((run_dir / "launch.json").read_text())
+    except (OSError, ValueError):
+        return {}
+
+
+def _follow(topics: Topics, run_dir: Path, nodes: list[str], ended) -> None:
+    """Feeds each trace's new lines until ended() is true, then what is left."""
+    follows = [(Follow(path), feed) for path, feed in topics.traces(run_dir, nodes)]
+    try:
+        while not ended():
+            for f, feed in follows:
+                lines = f.new_lines()
+                if lines:
+                    feed(lines)
+            time.sleep(POLL_S)
+        for f, feed in follows:
+            lines = f.rest()
+            if lines:
+                feed(lines)
+    finally:
+        for f, _ in follows:
+            f.close()

@@ -134,23 +134,99 @@ def _group_bits(ids, ext: bool, remote: bool, length: int, raw, np):
     if length and not remote:
         parts.append(np.unpackbits(np.ascontiguousarray(raw, dtype=np.uint8), axis=1))
     bits = np.concatenate(parts, axis=1)
-    # CRC-15, bit by bit over every frame at once
+    bits = np.concatenate([bits, field(_crc15_rows(bits, np), 15)], axis=1)
+    return bits.shape[1] + _stuff_rows(bits, np) + _TAIL_BITS
+
+
+def _crc15_table() -> list[int]:
+    """The CRC-15 register after eight bits (a byte, first bit most significant) from the
+    register holding that byte's value in its top eight bits."""
+    out = []
+    for byte in range(256):
+        crc = 0
+        for k in range(7, -1, -1):
+            nxt = ((byte >> k) & 1) ^ ((crc >> 14) & 1)
+            crc = (crc << 1) & 0x7FFF
+            if nxt:
+                crc ^= _CRC15_POLY
+        out.append(crc)
+    return out
+
+
+def _stuff_table() -> tuple[list[list[int]], list[list[int]]]:
+    """For each state before a byte of the bit stream (0..9: the last bit's value times 5 plus
+    the length of the run of equal bits so far minus 1; 10: at the start) and each byte: the
+    state after it and the stuff bits inserted in it (stuff_count, eight bits at a time)."""
+    nxt, cnt = [], []
+    for state in range(11):
+        row_n, row_c = [], []
+        for byte in range(256):
+            last, run = (state // 5, state % 5 + 1) if state < 10 else (-1, 0)
+            count = 0
+            for k in range(7, -1, -1):
+                b = (byte >> k) & 1
+                run = run + 1 if b == last else 1
+                last = b
+                if run == 5:  # a stuff bit of the other value: the first of the next run
+                    count += 1
+                    last, run = 1 - b, 1
+            row_n.append(last * 5 + run - 1)
+            row_c.append(count)
+        nxt.append(row_n)
+        cnt.append(row_c)
+    return nxt, cnt
+
+
+_TABLES: dict = {}
+
+
+def _tables(np):
+    if not _TABLES:
+        nxt, cnt = _stuff_table()
+        _TABLES.update(crc=np.array(_crc15_table(), dtype=np.int64),
+                       next=np.array(nxt, dtype=np.int32), count=np.array(cnt, dtype=np.int32))
+    return _TABLES
+
+
+def _crc15_rows(bits, np):
+    """crc15 of each row of a (m, n) 0/1 array: a byte at a time from a table, the last
+    bits one by one."""
+    t = _tables(np)["crc"]
+    m, n = bits.shape
+    full = n // 8
+    packed = np.packbits(bits[:, :full * 8], axis=1).astype(np.int64)
     crc = np.zeros(m, dtype=np.int64)
-    for k in range(bits.shape[1]):
+    for j in range(full):
+        crc = ((crc << 8) & 0x7FFF) ^ t[((crc >> 7) ^ packed[:, j]) & 0xFF]
+    for k in range(full * 8, n):
         nxt = bits[:, k].astype(np.int64) ^ ((crc >> 14) & 1)
         crc = ((crc << 1) & 0x7FFF) ^ (nxt * _CRC15_POLY)
-    bits = np.concatenate([bits, field(crc, 15)], axis=1)
-    # stuff bits: the run of equal bits so far, the stuff bit counting as the next run's first
+    return crc
+
+
+def _stuff_rows(bits, np):
+    """stuff_count of each row of a (m, n) 0/1 array: a byte at a time from a table, the last
+    bits one by one."""
+    t = _tables(np)
+    m, n = bits.shape
+    full = n // 8
+    packed = np.packbits(bits[:, :full * 8], axis=1).astype(np.int32)
+    nxt, cnt = t["next"].ravel(), t["count"].ravel()
+    state = np.full(m, 10 * 256, dtype=np.int32)  # state * 256: the row of the tables
     count = np.zeros(m, dtype=np.int64)
-    run = np.zeros(m, dtype=np.int64)
-    last = np.full(m, -1, dtype=np.int64)
-    for k in range(bits.shape[1]):
-        b = bits[:, k].astype(np.int64)
-        same = b == last
-        run = np.where(same, run + 1, 1)
+    for j in range(full):
+        idx = state + packed[:, j]
+        count += cnt[idx]
+        state = nxt[idx] * 256
+    state //= 256
+    last = np.where(state < 10, state // 5, -1)
+    run = np.where(state < 10, state % 5 + 1, 0)
+    for k in range(full * 8, n):
+        b = bits[:, k].astype(np.int32)
+        run = np.where(b == last, run + 1, 1)
         last = b
         stuffed = run == 5
         count += stuffed
         last = np.where(stuffed, 1 - b, last)
         run = np.where(stuffed, 1, run)
-    return bits.shape[1] + count + _TAIL_BITS
+    return count

@@ -6,7 +6,9 @@ of a long recording at once (`ima trace stats`). Read fast where the source allo
   one regular expression for the fields the statistics need; the number of matches is checked
   against the chunk's message index, and a chunk where they differ is read message by message
   instead (nothing is dropped silently);
-- a python-can log: python-can's reader, each message's fields appended to plain lists;
+- a BLF or ASC log of classic CAN: our own readers (blf.py, asc.py), which hand a log they do
+  not fully recognise to python-can's;
+- any other python-can log: python-can's reader, its messages' fields into one array;
 - anything else: source.load()'s frames, converted.
 """
 
@@ -75,7 +77,7 @@ def _data8(payloads: list[bytes]) -> np.ndarray:
     """(n, 8) uint8 from data of at most 8 bytes each."""
     if not payloads:
         return np.zeros((0, 8), dtype=np.uint8)
-    return np.frombuffer(np.array(payloads, dtype="S8").tobytes(), dtype=np.uint8).reshape(-1, 8)
+    return np.array(payloads, dtype="S8").view(np.uint8).reshape(-1, 8)
 
 
 def _hex8(hexes: list[bytes]) -> np.ndarray:
@@ -172,26 +174,50 @@ def _events(path: Path) -> tuple[list[dict], int]:
     return episodes, end
 
 
+_ROW = np.dtype([("t", "f8"), ("id", "i8"), ("ext", "?"), ("rtr", "?"), ("err", "?"),
+                 ("data", "S8"), ("dlen", "i8")])
+
+
 def _from_pycan(path: Path) -> Columns:
+    """A log through python-can's reader (a BLF or ASC of classic CAN through our own:
+    blf.py, asc.py)."""
     import can
 
-    t, ids, ext, rtr, err, data = [], [], [], [], [], []
+    suffix = path.suffix.lower()
+    if suffix in (".blf", ".asc"):
+        from ima.trace import asc, blf
+
+        try:
+            got = (blf if suffix == ".blf" else asc).read(path)
+        except (OSError, ValueError, struct.error) as e:
+            raise ImaError(f"{path}: not a readable log: {type(e).__name__}: {e}") from e
+        if got is not None:
+            t, ids, ext, rtr, err, data = got
+            return _columns(np.asarray(t, dtype=np.int64), ids, ext, rtr, err, data, path)
     try:
-        for m in can.LogReader(os.fspath(path)):
-            t.append(m.timestamp)
-            ids.append(m.arbitration_id)
-            ext.append(m.is_extended_id)
-            r, e = m.is_remote_frame, m.is_error_frame
-            rtr.append(r)
-            err.append(e)
-            data.append(b"" if r or e else bytes(m.data))
+        rows = np.fromiter(((m.timestamp, m.arbitration_id, m.is_extended_id,
+                             m.is_remote_frame, m.is_error_frame, bytes(m.data[:8]), len(m.data))
+                            for m in can.LogReader(os.fspath(path))), dtype=_ROW)
     except Exception as e:  # noqa: BLE001 - python-can's readers raise whatever they meet
         raise ImaError(f"{path}: python-can cannot read it: {type(e).__name__}: {e}") from e
-    ts = np.round(np.array(t, dtype=np.float64) * 1e9).astype(np.int64)
+    ts = np.round(rows["t"] * 1e9).astype(np.int64)
+    return _columns(ts, rows["id"], rows["ext"], rows["rtr"], rows["err"],
+                    rows["data"], path, rows["dlen"])
+
+
+def _columns(ts, ids, ext, rtr, err, data, path: Path, dlen=None) -> Columns:
+    """Columns from a log's fields: times from the first frame's, no data kept for remote and
+    error frames (as source.load gives them)."""
+    ts = np.asarray(ts, dtype=np.int64)
     if len(ts):
-        ts -= ts[0]
-    dlen = [min(len(d), 8) for d in data]
-    cols = _make(ts, ids, ext, rtr, err, dlen, _data8([d[:8] for d in data]), [], str(path),
-                 None, None)
+        ts = ts - ts[0]
+    rtr, err = np.asarray(rtr, dtype=bool), np.asarray(err, dtype=bool)
+    data8 = np.ascontiguousarray(np.asarray(data, dtype="S8")).view(np.uint8).reshape(-1, 8).copy()
+    if dlen is None:
+        dlen = np.fromiter(map(len, data), dtype=np.int64, count=len(data))
+    none = rtr | err
+    data8[none] = 0
+    dlen = np.where(none, 0, np.minimum(np.asarray(dlen, dtype=np.int64), 8))
+    cols = _make(ts, ids, ext, rtr, err, dlen, data8, [], str(path), None, None)
     cols.duration_ns = int(cols.t_ns[-1]) if len(cols) else None
     return cols

@@ -17,8 +17,8 @@ import time
 from pathlib import Path
 
 from ima.errors import ImaError
+from ima.recording.follow import Follow
 from ima.recording.topics import Topics
-from ima.websocket.follow import Follow
 from ima.websocket.server import DEFAULT_PORT, LiveServer
 
 POLL_S = 0.05

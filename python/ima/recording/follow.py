@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The complete lines a growing trace file has gained since the last look, numbered from 0 as
-the recording numbers them. A line still being written stays for the next look."""
+the recording numbers them. A line still being written stays for the next look. (The
+recorder and the live server follow a run's traces with it.)"""
 
 from __future__ import annotations
 
@@ -30,6 +31,16 @@ class Follow:
         first = self._next
         self._next += len(parts)
         return list(enumerate(parts, first))
+
+    def rest(self) -> list[tuple[int, bytes]]:
+        """The last line if its writer never ended it (a cut line: the reader skips and counts
+        it), once the file is complete; read first what new_lines() has not."""
+        lines = self.new_lines()
+        if self._tail:
+            lines.append((self._next, self._tail))
+            self._next += 1
+            self._tail = b""
+        return lines
 
     def close(self) -> None:
         if self._f is not None:

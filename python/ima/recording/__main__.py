@@ -50,6 +50,17 @@ class _Stdin:
             self._read(None)
 
 
+def _yield_to_the_flight() -> None:
+    """Run only on CPU time the run leaves idle (SCHED_IDLE; else the lowest priority)."""
+    try:
+        os.sched_setscheduler(0, os.SCHED_IDLE, os.sched_param(0))
+    except (OSError, AttributeError):
+        try:
+            os.nice(19)
+        except OSError:
+            pass
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m ima.recording")
     p.add_argument("run_dir", type=Path)
@@ -60,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
     stdin = _Stdin()
     if args.follow:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
-        os.nice(10)  # the flight first
+        _yield_to_the_flight()
 
     def wait() -> None:
         if args.wait_summary:

@@ -96,15 +96,9 @@ class McapWriter:
         idx = self.index.get(cid)
         if idx is None:
             idx = self.index[cid] = []
-        idx.append(t)
-        idx.append(len(buf))
+        idx += (t, len(buf))
         buf += _MSG.pack(OP_MESSAGE, 22 + len(data), cid, seq & 0xFFFFFFFF, t, t)
         buf += data
-        self.counts[cid] += 1
-        if self.c_min is None or t < self.c_min:
-            self.c_min = t
-        if t > self.c_max:
-            self.c_max = t
         if len(buf) >= self.chunk_bytes:
             self._flush_chunk()
 
@@ -112,6 +106,12 @@ class McapWriter:
         if not self.index:
             self._new_chunk()  # definitions only: they are in the summary as well
             return
+        for cid, entries in self.index.items():  # the chunk's times and counts
+            times = entries[0::2]
+            lo, hi = min(times), max(times)
+            self.c_min = lo if self.c_min is None else min(self.c_min, lo)
+            self.c_max = max(self.c_max, hi)
+            self.counts[cid] += len(times)
         raw = bytes(self.buf)
         comp = self.zstd.compress(raw)
         start = self.pos

@@ -48,6 +48,7 @@ class Topics:
         self._origin: tuple[float, float] | None = None  # the truth's first position
         self._sig_schema: dict[str, bytes] = {}
         self._extra_of: dict[tuple, bytes] = {}  # a frame's added fields, by id and kind
+        self._sig_names: dict[str, tuple] = {}  # a message's topic, schema name and signals
 
     def traces(self, run_dir: Path, nodes: list[str]) -> list[tuple[Path, Callable[[Lines], None]]]:
         """Every line-based trace of a run with its feeder, in the recording's order."""
@@ -134,6 +135,7 @@ class Topics:
         event_schema = schemas.BUS_EVENT
         put, by_id, dumps = self.out.put, codec.BY_ID, orjson.dumps
         extra_of = self._extra_of
+        sig_names = self._sig_names
         for i, line, r in self._parsed(lines, "can.jsonl"):
             kind, t = r.get("kind"), r.get("t_ns", 0)
             if kind not in ("can_tx", "can_error"):
@@ -156,9 +158,14 @@ class Topics:
                     values = msg.decode(bytes.fromhex(r.get("data", "")))
                 except (ValueError, IndexError):
                     continue
-                put(f"/can/signals/{msg.name}", f"ima.can.{msg.name}", self._signals(msg), t,
-                    dumps(dict(zip(msg.signal_names, values, strict=True)) | {
-                        "t_ns": t, "from": r.get("from")}), i)
+                names = sig_names.get(msg.name)
+                if names is None:
+                    names = sig_names[msg.name] = (f"/can/signals/{msg.name}",
+                                                   f"ima.can.{msg.name}", msg.signal_names)
+                rec = dict(zip(names[2], values, strict=True))
+                rec["t_ns"] = t
+                rec["from"] = r.get("from")
+                put(names[0], names[1], self._signals(msg), t, dumps(rec), i)
 
     def ske(self, node: str, lines: Lines) -> None:
         """A node's SKE trace: its schedule, its health monitor's events, the rest."""

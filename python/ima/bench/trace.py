@@ -8,8 +8,9 @@
   whole command (target ≤ 2 s);
 - stats_s_1h: the same on a 1-hour recording, made of six copies of the 10-minute flight's
   CAN frames one after the other (target ≤ 10 s);
-- pycan_read_ratio: `ima trace stats` of that flight's frames exported as BLF, then ASC,
-  against python-can's own reader merely reading the file (target ≤ 1.5; the larger of two);
+- pycan_read_ratio: `ima trace stats`'s reading and analysis (in this process) of that
+  flight's frames exported as BLF, then ASC, against python-can's own reader merely reading
+  the file (target ≤ 1.5; the larger of two);
 - recording_mb_10min: the size of the 10-minute recording.
 """
 
@@ -107,9 +108,9 @@ def measure(duration: int = 120, pairs: int = 3, progress=None) -> dict:
             _ima("trace", "export", str(long_run), "--format", fmt, "-o", str(log))
             read = _pycan_read_s(log)
             t = time.perf_counter()
-            from ima.trace import source, stats
+            from ima.trace import columns, stats
 
-            stats.compute(source.load(log), stats.load_dbc(None))
+            stats.compute(columns.load(log), stats.load_dbc(None))  # as `ima trace stats` does
             ours = time.perf_counter() - t
             ratios_pycan[fmt] = round(ours / read, 2)
         result = {

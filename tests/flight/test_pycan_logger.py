@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
-"""python-can on the live bus: `python -m can.logger -i ima` records a real-time flight and
-every frame of its log decodes with the DBC."""
+"""python-can on the live bus: `python -m can.logger -i ima` records a real-time flight,
+every frame of its log decodes with the DBC, and `ima trace stats` analyses the log."""
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 import time
@@ -52,3 +53,13 @@ def test_can_logger_records_the_live_bus_and_the_log_decodes(tmp_path):
     assert seen["ACT_CMD_A"] > 60, seen
     assert seen["FCS_STATUS_A"] > 60, seen
     assert {"AIR_DATA", "ACT_STATUS", "PILOT_MODE", "PILOT_TARGETS", "NAV_POS_A"} <= set(seen)
+
+    stats = subprocess.run([sys.executable, "-m", "ima", "trace", "stats", str(log), "--json"],
+                           capture_output=True, text=True, timeout=120)
+    assert stats.returncode == 0, stats.stderr
+    r = json.loads(stats.stdout)
+    assert r["frames"] == sum(seen.values()) and r["error_frames"] == 0
+    by_name = {i["name"]: i for i in r["ids"]}
+    assert by_name["AHRS_ATT"]["count"] == seen["AHRS_ATT"]
+    assert 15 <= by_name["AHRS_ATT"]["period_ms_p50"] <= 25  # 50 Hz, on the wall clock
+    assert 0 < r["bus_load"] < r["bus_load_worst_case"]

@@ -44,6 +44,15 @@ def _refused(answer: bytes) -> int:
     return rec.id
 
 
+def _close(bus: subprocess.Popen, clients: list[socket.socket]) -> None:
+    for c in clients:
+        c.close()
+    if bus.poll() is None:
+        bus.kill()
+        bus.wait()
+    bus.stderr.close()
+
+
 def _next_tick(s: socket.socket) -> int:
     while True:
         for rec in proto.unpack_recs(s.recv(proto.MAX_DATAGRAM)):
@@ -108,12 +117,7 @@ def test_what_the_bus_refuses_and_rejects(tmp_path):
         node.send(proto.pack_rec(proto.MSG_STOP, id_=proto.STOP_REQUESTED))
         assert bus.wait(timeout=30) == 0, bus.stderr.read()
     finally:
-        for c in clients:
-            c.close()
-        if bus.poll() is None:
-            bus.kill()
-            bus.wait()
-        bus.stderr.close()
+        _close(bus, clients)
     st = json.loads(stats.read_text())
     assert (st["bad_hellos"], st["late_joins"], st["refused_full"]) == (3, 1, 1), st
     assert st["rejected"] == 1 + 7 + 9 and st["garbage_disconnects"] == 1, st
@@ -191,12 +195,7 @@ def test_a_client_that_stops_reading_is_queued_for_then_dropped(tmp_path):
         reader.join(timeout=20)
         assert not reader.is_alive()
     finally:
-        for c in clients:
-            c.close()
-        if bus.poll() is None:
-            bus.kill()
-            bus.wait()
-        bus.stderr.close()
+        _close(bus, clients)
     st = json.loads(stats.read_text())
     assert st["send_timeouts"] == 1, st
     leaves = [json.loads(line) for line in trace.read_text().splitlines()

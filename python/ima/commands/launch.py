@@ -32,14 +32,19 @@ def positive_float(text: str) -> float:
     return v
 
 
-def wind_kt(text: str) -> float:
+def _within(text: str, kind, lo, hi, what: str, bad: str):
+    """text as `kind` (float or int) within lo..hi; argparse's error otherwise."""
     try:
-        v = float(text)
+        v = kind(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: '{text}'") from None
-    if not 0 <= v <= 60:
-        raise argparse.ArgumentTypeError(f"wind must be within 0..60 kt, not '{text}'")
+        raise argparse.ArgumentTypeError(f"{what}: '{text}'") from None
+    if not lo <= v <= hi:
+        raise argparse.ArgumentTypeError(f"{bad}, not '{text}'")
     return v
+
+
+def wind_kt(text: str) -> float:
+    return _within(text, float, 0, 60, "not a number", "wind must be within 0..60 kt")
 
 
 def _node_at(option: str):
@@ -60,13 +65,7 @@ def _wrong(text: str) -> tuple[str, str, float, float]:
 
 
 def _port(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a port number: '{text}'") from None
-    if not 0 <= v <= 65535:
-        raise argparse.ArgumentTypeError(f"a port is 0..65535, not '{text}'")
-    return v
+    return _within(text, int, 0, 65535, "not a port number", "a port is 0..65535")
 
 
 def add_run_arguments(parser: argparse.ArgumentParser, kind: str = "launch") -> None:

@@ -68,6 +68,19 @@ def _summary(f) -> tuple[dict[int, str], list[tuple[int, int, dict[int, int], st
     return channels, chunks
 
 
+def _records(f, start: int, length: int, dctx) -> bytes:
+    """The records of the chunk at `start`, decompressed."""
+    f.seek(start)
+    chunk = f.read(length)
+    if chunk[0] != OP_CHUNK:
+        raise ValueError(f"no chunk at {start}")
+    raw_size = _U64.unpack_from(chunk, 9 + 16)[0]
+    comp_name, p = _string(chunk, 9 + 28)
+    n = _U64.unpack_from(chunk, p)[0]
+    data = chunk[p + 8:p + 8 + n]
+    return dctx.decompress(data, max_output_size=raw_size) if comp_name else data
+
+
 def messages(path: Path, topics: list[str]) -> Iterator[tuple[str, int, bytes]]:
     """(topic, log time, data) of the messages of `topics`, chunk by chunk, topic by topic
     within a chunk, each topic's in the order written."""
@@ -87,15 +100,7 @@ def messages(path: Path, topics: list[str]) -> Iterator[tuple[str, int, bytes]]:
         for start, length, idx, _ in chunks:
             if not want.keys() & idx.keys():
                 continue
-            f.seek(start)
-            chunk = f.read(length)
-            if chunk[0] != OP_CHUNK:
-                raise ValueError(f"no chunk at {start}")
-            raw_size = _U64.unpack_from(chunk, 9 + 16)[0]
-            comp_name, p = _string(chunk, 9 + 28)
-            n = _U64.unpack_from(chunk, p)[0]
-            data = chunk[p + 8:p + 8 + n]
-            records = dctx.decompress(data, max_output_size=raw_size) if comp_name else data
+            records = _records(f, start, length, dctx)
             # the chunk's message indexes give each wanted message's offset: no walk over the
             # others (a chunk of the CAN section holds the decoded signals as well)
             for cid in sorted(want.keys() & idx.keys()):
@@ -136,16 +141,7 @@ def _chunk_records(path: Path, index, want: set[int]) -> Iterator[tuple[bytes, i
             for cid in want & idx.keys():  # each message index: (time, offset) pairs
                 f.seek(idx[cid] + 9 + 2)
                 count += _U32.unpack(f.read(4))[0] // 16
-            f.seek(start)
-            chunk = f.read(length)
-            if chunk[0] != OP_CHUNK:
-                raise ValueError(f"no chunk at {start}")
-            raw_size = _U64.unpack_from(chunk, 9 + 16)[0]
-            comp_name, p = _string(chunk, 9 + 28)
-            n = _U64.unpack_from(chunk, p)[0]
-            data = chunk[p + 8:p + 8 + n]
-            records = dctx.decompress(data, max_output_size=raw_size) if comp_name else data
-            yield records, count
+            yield _records(f, start, length, dctx), count
 
 
 def _fallback(path: Path, topics: list[str]):

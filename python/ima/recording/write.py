@@ -4,10 +4,10 @@
 The recording is made from the producers' own traces: while the run flies, following them as
 they grow (the launcher's way), or once it has ended, or from whatever a killed run left
 (`ima trace recover`). After Ctrl-C every trace is complete up to the stop; a line cut by a
-kill is skipped and counted. Each message's log
-time is the record's emulated time (t_ns); its sequence number is the record's number (its
-line, from 0) in its producer's trace, so a reader can check that nothing was dropped. The
-file is written beside as run.mcap.part and renamed when complete.
+kill is skipped and counted. Each message's log time is the record's emulated time (t_ns);
+its sequence number is the record's number (its line, from 0) in its producer's trace, so a
+reader can check that nothing was dropped. The file is written beside as run.mcap.part and
+renamed when complete.
 """
 
 from __future__ import annotations

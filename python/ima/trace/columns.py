@@ -146,7 +146,10 @@ def _from_mcap(path: Path, bitrate: int | None) -> Columns | None:
     err = np.array(kind) == b"e"
     rtr = np.array(rtr) != b""
     data = _hex8(list(hexes))
-    dlen = np.where(err | rtr, 0, np.array(length, dtype="S3").astype(np.int64))
+    length = np.array(length, dtype="S3").astype(np.int64)
+    if bool((length > 8).any()):
+        return None  # not classic CAN: read message by message
+    dlen = np.where(err | rtr, 0, length)
     end = max(end, int(t.max()))
     return _make(t, np.array(ids, dtype="S10").astype(np.int64), np.array(ext) == b"t", rtr,
                  err, dlen, data, bus_off, str(path), bitrate, end or None)

@@ -68,7 +68,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--follow", action="store_true")
     p.add_argument("--nodes", help="the run's nodes, comma-separated (with --follow)")
     args = p.parse_args(argv)
-    stdin = _Stdin()
+    stdin = _Stdin() if args.follow or args.wait_summary else None  # the launcher's word
     if args.follow:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         _yield_to_the_flight()

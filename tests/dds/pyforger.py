@@ -19,7 +19,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from dds_helpers import inputs_for  # noqa: E402
+from dds_helpers import dds_inputs  # noqa: E402
 
 from ima import dds  # noqa: E402
 
@@ -48,16 +48,6 @@ def main() -> int:
               Policy.Liveliness.Automatic(duration(seconds=1)),
               Policy.WriterDataLifecycle(False))
 
-    def sample(node: int) -> CrossChannelInputs:
-        x = inputs_for(node, 0, 0b11)
-        return CrossChannelInputs(node=node, frame=0, t_ns=0, valid=x.valid,
-                                  wait_mask=x.wait_mask, gps_t_ns=x.gps_t_ns,
-                                  ahrs_t_ns=x.ahrs_t_ns, air_t_ns=x.air_t_ns,
-                                  gps_seq=x.gps_seq, gps_fix=x.gps_fix, gps_sats=x.gps_sats,
-                                  ahrs_seq=x.ahrs_seq, ahrs_status=x.ahrs_status,
-                                  air_seq=x.air_seq, air_status=x.air_status, gps=x.gps,
-                                  ahrs=x.ahrs, air=x.air)
-
     def write_all(specs: list[tuple[list[str], int]]) -> list:
         made = []
         for parts, node in specs:
@@ -67,7 +57,7 @@ def main() -> int:
         for wr, node in made:
             while not wr.get_matched_subscriptions() and time.monotonic() < end:
                 time.sleep(0.01)
-            wr.write(sample(node))
+            wr.write(dds_inputs(node, 0, 0b11))
         return made
 
     gone = write_all([(["node2"], 2)] * args.gone)

@@ -20,7 +20,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from dds_helpers import inputs_for  # noqa: E402
+from dds_helpers import dds_inputs  # noqa: E402
 
 from ima import dds  # noqa: E402
 
@@ -62,17 +62,8 @@ def main() -> int:
     wr = writers["rpas_CrossChannelInputs"]
     while not wr.get_matched_subscriptions() and time.monotonic() < end:
         time.sleep(0.01)
-    from ima.dds.types import CrossChannelInputs
-
     for f in range(args.frames):
-        x = inputs_for(args.node, f, 0b11)
-        wr.write(CrossChannelInputs(node=args.node, frame=f, t_ns=f * 50_000_000, valid=x.valid,
-                                    wait_mask=x.wait_mask, gps_t_ns=x.gps_t_ns,
-                                    ahrs_t_ns=x.ahrs_t_ns, air_t_ns=x.air_t_ns,
-                                    gps_seq=x.gps_seq, gps_fix=x.gps_fix, gps_sats=x.gps_sats,
-                                    ahrs_seq=x.ahrs_seq, ahrs_status=x.ahrs_status,
-                                    air_seq=x.air_seq, air_status=x.air_status, gps=x.gps,
-                                    ahrs=x.ahrs, air=x.air))
+        wr.write(dds_inputs(args.node, f, 0b11))
     rd = readers["rpas_CrossChannelInputs"]
     got = 0
     while got < args.frames and time.monotonic() < end:

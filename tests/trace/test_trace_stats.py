@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ima.errors import ImaError
@@ -149,6 +150,9 @@ def test_many_frames_at_once_have_the_lengths_of_each_alone():
                                         for _ in range(n))
         frames.append((r.choice((0, (1 << (29 if ext else 11)) - 1, r.getrandbits(
             29 if ext else 11))), ext, remote, data))
-    many = bits.frame_bits_many([f[0] for f in frames], [f[1] for f in frames],
-                                [f[2] for f in frames], [f[3] for f in frames])
+    data8 = np.zeros((len(frames), 8), dtype=np.uint8)
+    for k, f in enumerate(frames):
+        data8[k, :len(f[3])] = list(f[3])
+    many = bits.frame_bits_columns([f[0] for f in frames], [f[1] for f in frames],
+                                   [f[2] for f in frames], [len(f[3]) for f in frames], data8)
     assert list(many) == [bits.frame_bits(i, e, d, rt) for i, e, rt, d in frames]

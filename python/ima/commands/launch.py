@@ -220,7 +220,7 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
 
             result = launch_run.launch(opts, on_status=on_status)
     except BaseException:
-        recording.abandon(recorder)
+        recording.abandon(recorder, Path(opts.run_dir))
         raise
     finally:
         served_counts = live_server.finish(served[0]) if served is not None else {}

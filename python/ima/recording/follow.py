@@ -5,6 +5,8 @@ recorder and the live server follow a run's traces with it.)"""
 
 from __future__ import annotations
 
+import time
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 
@@ -46,3 +48,24 @@ class Follow:
         if self._f is not None:
             self._f.close()
             self._f = None
+
+
+def feed_until(traces: Iterable[tuple[Path, Callable]], ended: Callable[[], bool],
+               poll_s: float) -> None:
+    """Follows each (trace, feed) and hands feed its new lines every poll_s until ended() is
+    true (the writers have stopped), then what is left, a cut last line included."""
+    follows = [(Follow(path), feed) for path, feed in traces]
+    try:
+        while not ended():
+            for f, feed in follows:
+                lines = f.new_lines()
+                if lines:
+                    feed(lines)
+            time.sleep(poll_s)
+        for f, feed in follows:
+            lines = f.rest()
+            if lines:
+                feed(lines)
+    finally:
+        for f, _ in follows:
+            f.close()

@@ -35,17 +35,13 @@ def flown(proc: subprocess.Popen | None) -> None:
         pass  # it has failed: finish() says why
 
 
-def abandon(proc: subprocess.Popen | None) -> None:
+def abandon(proc: subprocess.Popen | None, run_dir: Path) -> None:
     """The run did not start or failed to: no recording (its partial file is removed)."""
     if proc is None:
         return
     proc.kill()
     proc.communicate()
-    try:
-        run_dir = Path(proc.args[3])
-        (run_dir / (NAME + ".part")).unlink(missing_ok=True)
-    except (IndexError, TypeError, OSError):
-        pass
+    (Path(run_dir) / (NAME + ".part")).unlink(missing_ok=True)
 
 
 def finish(proc: subprocess.Popen | None, timeout_s: float = 600.0) -> dict:

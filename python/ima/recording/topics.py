@@ -46,9 +46,8 @@ class Topics:
         self.out = out
         self.skipped: dict[str, int] = {}
         self._origin: tuple[float, float] | None = None  # the truth's first position
-        self._sig_schema: dict[str, bytes] = {}
         self._extra_of: dict[tuple, bytes] = {}  # a frame's added fields, by id and kind
-        self._sig_names: dict[str, tuple] = {}  # a message's topic, schema name and signals
+        self._sig: dict[str, tuple] = {}  # a message's topic, schema name, schema, signals
 
     def traces(self, run_dir: Path, nodes: list[str]) -> list[tuple[Path, Callable[[Lines], None]]]:
         """Every line-based trace of a run with its feeder, in the recording's order."""
@@ -61,11 +60,14 @@ class Topics:
         out.append((run_dir / "truth.jsonl", self.truth))
         return out
 
-    def _signals(self, msg) -> bytes:
-        schema = self._sig_schema.get(msg.name)
-        if schema is None:
-            schema = self._sig_schema[msg.name] = schemas.signals(msg.name, msg.signal_names)
-        return schema
+    def _signals(self, msg) -> tuple[str, str, bytes, tuple[str, ...]]:
+        """The topic, schema name, schema and signal names of a DBC message's signals."""
+        sig = self._sig.get(msg.name)
+        if sig is None:
+            sig = self._sig[msg.name] = (f"/can/signals/{msg.name}", f"ima.can.{msg.name}",
+                                         schemas.signals(msg.name, msg.signal_names),
+                                         msg.signal_names)
+        return sig
 
     def topics(self, nodes: list[str]) -> list[tuple[str, str, bytes]]:
         """(topic, schema name, schema) of every topic the traces can give messages on (a live
@@ -78,8 +80,7 @@ class Topics:
         for msg in codec.BY_ID.values():
             if msg.name not in seen:
                 seen.add(msg.name)
-                out.append((f"/can/signals/{msg.name}", f"ima.can.{msg.name}",
-                            self._signals(msg)))
+                out.append(self._signals(msg)[:3])
         for node in nodes:
             out += [(f"/{node}/{v}", "ima.SkeEvent", schemas.SKE_EVENT)
                     for v in ("schedule", "hm", "events")]
@@ -135,7 +136,7 @@ class Topics:
         event_schema = schemas.BUS_EVENT
         put, by_id, dumps = self.out.put, codec.BY_ID, orjson.dumps
         extra_of = self._extra_of
-        sig_names = self._sig_names
+        signals = self._signals
         for i, line, r in self._parsed(lines, "can.jsonl"):
             kind, t = r.get("kind"), r.get("t_ns", 0)
             if kind not in ("can_tx", "can_error"):
@@ -158,14 +159,11 @@ class Topics:
                     values = msg.decode(bytes.fromhex(r.get("data", "")))
                 except (ValueError, IndexError):
                     continue
-                names = sig_names.get(msg.name)
-                if names is None:
-                    names = sig_names[msg.name] = (f"/can/signals/{msg.name}",
-                                                   f"ima.can.{msg.name}", msg.signal_names)
-                rec = dict(zip(names[2], values, strict=True))
+                topic, schema_name, schema, names = signals(msg)
+                rec = dict(zip(names, values, strict=True))
                 rec["t_ns"] = t
                 rec["from"] = r.get("from")
-                put(names[0], names[1], self._signals(msg), t, dumps(rec), i)
+                put(topic, schema_name, schema, t, dumps(rec), i)
 
     def ske(self, node: str, lines: Lines) -> None:
         """A node's SKE trace: its schedule, its health monitor's events, the rest."""

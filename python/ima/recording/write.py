@@ -14,14 +14,13 @@ from __future__ import annotations
 
 import json
 import os
-import time
 from pathlib import Path
 
 import orjson
 
 from ima.errors import ImaError
 from ima.recording import schemas
-from ima.recording.follow import Follow
+from ima.recording.follow import feed_until
 from ima.recording.topics import Topics
 
 NAME = "run.mcap"
@@ -140,7 +139,7 @@ def record(run_dir: Path, output: Path | None = None, before_verdicts=None,
             out = _Out(f)
             topics = Topics(out)
             if follow is not None:
-                _follow(topics, run_dir, list(nodes or []), follow)
+                feed_until(topics.traces(run_dir, list(nodes or [])), follow, POLL_S)
             launch = _launch(run_dir)
             nodes = list(nodes or launch.get("nodes") or sorted(
                 p.stem for p in run_dir.glob("node*.jsonl") if p.stem[4:].isdigit()))
@@ -171,22 +170,3 @@ def _launch(run_dir: Path) -> dict:
         return json.loads((run_dir / "launch.json").read_text())
     except (OSError, ValueError):
         return {}
-
-
-def _follow(topics: Topics, run_dir: Path, nodes: list[str], ended) -> None:
-    """Feeds each trace's new lines until ended() is true, then what is left."""
-    follows = [(Follow(path), feed) for path, feed in topics.traces(run_dir, nodes)]
-    try:
-        while not ended():
-            for f, feed in follows:
-                lines = f.new_lines()
-                if lines:
-                    feed(lines)
-            time.sleep(POLL_S)
-        for f, feed in follows:
-            lines = f.rest()
-            if lines:
-                feed(lines)
-    finally:
-        for f, _ in follows:
-            f.close()

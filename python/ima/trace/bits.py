@@ -83,21 +83,11 @@ def worst_case_bits(extended: bool, length: int) -> int:
     return g + 8 * length + 13 + (g + 8 * length - 1) // 4
 
 
-def frame_bits_many(ids, extended, remote, datas: list[bytes]):
-    """frame_bits of many frames at once (numpy, one pass over the bit positions per group of
-    frames of the same layout): the same numbers, some fifty times faster on long traces."""
-    import numpy as np
-
-    lens = np.fromiter((len(d) for d in datas), dtype=np.int64, count=len(datas))
-    data8 = np.zeros((len(datas), 8), dtype=np.uint8)
-    for i, d in enumerate(datas):
-        data8[i, :len(d)] = np.frombuffer(d, dtype=np.uint8)
-    return frame_bits_columns(ids, extended, remote, lens, data8)
-
-
 def frame_bits_columns(ids, extended, remote, lens, data8):
-    """frame_bits_many of frames given as columns: `lens` their data lengths (0 to 8), `data8`
-    an (n, 8) uint8 array of their data."""
+    """frame_bits of many frames at once, given as columns: `lens` their data lengths (0 to 8),
+    `data8` an (n, 8) uint8 array of their data. One pass per group of frames of the same
+    layout (numpy), the CRC and the stuff bits a byte at a time from tables: the same numbers,
+    a hundred times faster on long traces."""
     import numpy as np
 
     n = len(lens)
@@ -141,16 +131,7 @@ def _group_bits(ids, ext: bool, remote: bool, length: int, raw, np):
 def _crc15_table() -> list[int]:
     """The CRC-15 register after eight bits (a byte, first bit most significant) from the
     register holding that byte's value in its top eight bits."""
-    out = []
-    for byte in range(256):
-        crc = 0
-        for k in range(7, -1, -1):
-            nxt = ((byte >> k) & 1) ^ ((crc >> 14) & 1)
-            crc = (crc << 1) & 0x7FFF
-            if nxt:
-                crc ^= _CRC15_POLY
-        out.append(crc)
-    return out
+    return [crc15(_bits(byte, 8)) for byte in range(256)]
 
 
 def _stuff_table() -> tuple[list[list[int]], list[list[int]]]:

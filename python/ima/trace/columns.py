@@ -161,20 +161,14 @@ def _events(path: Path) -> tuple[list[dict], int]:
 
     from ima.recording import mcapread
 
-    off: dict[str, dict] = {}
-    episodes: list[dict] = []
+    off = source.BusOff()
     end = 0
     for _, _, raw in mcapread.messages(path, ["/can/events"]):
         r = orjson.loads(raw)
         t = r.get("t_ns", 0)
         end = max(end, t)
-        name = str(r.get("name"))
-        if r.get("kind") == "bus_off":
-            ep = off[name] = {"t_s": t / 1e9, "client": r.get("name"), "until_s": None}
-            episodes.append(ep)
-        elif r.get("kind") == "bus_on" and name in off:
-            off.pop(name)["until_s"] = t / 1e9
-    return episodes, end
+        off.event(t, r.get("kind"), r.get("name"))
+    return off.episodes, end
 
 
 _ROW = np.dtype([("t", "f8"), ("id", "i8"), ("ext", "?"), ("rtr", "?"), ("err", "?"),
@@ -184,8 +178,6 @@ _ROW = np.dtype([("t", "f8"), ("id", "i8"), ("ext", "?"), ("rtr", "?"), ("err", 
 def _from_pycan(path: Path) -> Columns:
     """A log through python-can's reader (a BLF or ASC of classic CAN through our own:
     blf.py, asc.py)."""
-    import can
-
     suffix = path.suffix.lower()
     if suffix in (".blf", ".asc"):
         from ima.trace import asc, blf
@@ -197,6 +189,8 @@ def _from_pycan(path: Path) -> Columns:
         if got is not None:
             t, ids, ext, rtr, err, data = got
             return _columns(np.asarray(t, dtype=np.int64), ids, ext, rtr, err, data, path)
+    import can
+
     try:
         rows = np.fromiter(((m.timestamp, m.arbitration_id, m.is_extended_id,
                              m.is_remote_frame, m.is_error_frame, bytes(m.data[:8]), len(m.data))
@@ -221,6 +215,5 @@ def _columns(ts, ids, ext, rtr, err, data, path: Path, dlen=None) -> Columns:
     none = rtr | err
     data8[none] = 0
     dlen = np.where(none, 0, np.minimum(np.asarray(dlen, dtype=np.int64), 8))
-    cols = _make(ts, ids, ext, rtr, err, dlen, data8, [], str(path), None, None)
-    cols.duration_ns = int(cols.t_ns[-1]) if len(cols) else None
-    return cols
+    return _make(ts, ids, ext, rtr, err, dlen, data8, [], str(path), None,
+                 int(ts.max()) if len(ts) else None)

@@ -40,6 +40,21 @@ class Trace:
     duration_ns: int | None = None
 
 
+class BusOff:
+    """The bus-off episodes of a bus's events, fed in time order."""
+
+    def __init__(self) -> None:
+        self.episodes: list[dict] = []  # {"t_s", "client", "until_s"}
+        self._open: dict[str, dict] = {}
+
+    def event(self, t_ns: int, kind, name) -> None:
+        if kind == "bus_off":
+            ep = self._open[str(name)] = {"t_s": t_ns / 1e9, "client": name, "until_s": None}
+            self.episodes.append(ep)
+        elif kind == "bus_on" and str(name) in self._open:
+            self._open.pop(str(name))["until_s"] = t_ns / 1e9
+
+
 def load(path: Path) -> Trace:
     """A run directory, its can.jsonl, or a python-can log."""
     path = Path(path)
@@ -74,8 +89,7 @@ def _run_bitrate(run_dir: Path) -> int | None:
 
 def _from_bus_trace(path: Path, bitrate: int | None) -> Trace:
     frames: list[Frame] = []
-    off: dict[str, dict] = {}
-    episodes: list[dict] = []
+    off = BusOff()
     end = 0
     try:
         f = open(path, "rb")  # noqa: SIM115 - closed below
@@ -97,16 +111,10 @@ def _from_bus_trace(path: Path, bitrate: int | None) -> Trace:
                 frames.append(Frame(t, int(r["id"]), bool(r.get("ext")), data, remote,
                                     kind == "can_error", str(r.get("from", "")),
                                     int(r.get("len", len(data))) if remote else -1))
-            elif kind == "bus_off":
-                ep = {"t_s": t / 1e9, "client": r.get("name"), "until_s": None}
-                off[str(r.get("name"))] = ep
-                episodes.append(ep)
-            elif kind == "bus_on":
-                ep = off.pop(str(r.get("name")), None)
-                if ep is not None:
-                    ep["until_s"] = t / 1e9
+            else:
+                off.event(t, kind, r.get("name"))
     frames.sort(key=lambda fr: fr.t_ns)
-    return Trace(frames, episodes, str(path), bitrate, end or None)
+    return Trace(frames, off.episodes, str(path), bitrate, end or None)
 
 
 def _from_mcap(path: Path, bitrate: int | None) -> Trace:
@@ -118,8 +126,7 @@ def _from_mcap(path: Path, bitrate: int | None) -> Trace:
     from ima.recording import mcapread
 
     frames: list[Frame] = []
-    off: dict[str, dict] = {}
-    episodes: list[dict] = []
+    off = BusOff()
     end = 0
     try:
         for topic, _, raw in mcapread.messages(path, ["/can/frames", "/can/events"]):
@@ -133,16 +140,12 @@ def _from_mcap(path: Path, bitrate: int | None) -> Trace:
                 frames.append(Frame(t, int(r["id"]), bool(r.get("ext")), data, remote, error,
                                     str(r.get("from", "")),
                                     int(r.get("len", 0)) if remote else -1))
-            elif r.get("kind") == "bus_off":
-                ep = off[str(r.get("name"))] = {"t_s": t / 1e9, "client": r.get("name"),
-                                                "until_s": None}
-                episodes.append(ep)
-            elif r.get("kind") == "bus_on" and str(r.get("name")) in off:
-                off.pop(str(r.get("name")))["until_s"] = t / 1e9
+            else:
+                off.event(t, r.get("kind"), r.get("name"))
     except (OSError, ValueError, struct.error, McapError) as e:
         raise ImaError(f"{path}: not a readable recording: {e}") from e
     frames.sort(key=lambda fr: fr.t_ns)
-    return Trace(frames, episodes, str(path), bitrate, end or None)
+    return Trace(frames, off.episodes, str(path), bitrate, end or None)
 
 
 def _from_pycan(path: Path) -> Trace:

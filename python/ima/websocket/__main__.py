@@ -13,11 +13,10 @@ import argparse
 import json
 import select
 import sys
-import time
 from pathlib import Path
 
 from ima.errors import ImaError
-from ima.recording.follow import Follow
+from ima.recording.follow import feed_until
 from ima.recording.topics import Topics
 from ima.websocket.server import DEFAULT_PORT, LiveServer
 
@@ -31,20 +30,10 @@ def serve(run_dir: Path, nodes: list[str], port: int, stop) -> dict[str, int]:
     for topic, schema_name, schema in topics.topics(nodes):
         server.channel(topic, schema_name, schema)  # advertised before the run starts
     print(json.dumps({"url": server.url, "port": server.port}), flush=True)
-    follows = [(Follow(path), feed) for path, feed in topics.traces(run_dir, nodes)]
     try:
-        while True:
-            last = stop()
-            for f, feed in follows:
-                lines = f.new_lines()
-                if lines:
-                    feed(lines)
-            if last:
-                return server.counts
-            time.sleep(POLL_S)
+        feed_until(topics.traces(run_dir, nodes), stop, POLL_S)
+        return server.counts
     finally:
-        for f, _ in follows:
-            f.close()
         server.stop()
 
 

@@ -467,6 +467,7 @@ static void inputs_from_dds(struct xch_inputs *x, const rpas_CrossChannelInputs 
     x->ahrs_status = s->ahrs_status;
     x->air_seq = s->air_seq;
     x->air_status = s->air_status;
+    x->plan_crc = s->plan_crc;
     memcpy(x->gps, s->gps, sizeof x->gps);
     memcpy(x->ahrs, s->ahrs, sizeof x->ahrs);
     memcpy(x->air, s->air, sizeof x->air);
@@ -486,6 +487,7 @@ static void inputs_to_dds(rpas_CrossChannelInputs *s, const struct xch_inputs *x
     s->ahrs_status = x->ahrs_status;
     s->air_seq = x->air_seq;
     s->air_status = x->air_status;
+    s->plan_crc = x->plan_crc;
     memcpy(s->gps, x->gps, sizeof s->gps);
     memcpy(s->ahrs, x->ahrs, sizeof s->ahrs);
     memcpy(s->air, x->air, sizeof s->air);

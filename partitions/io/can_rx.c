@@ -11,6 +11,7 @@
 void io_rx_init(io_rx_t *rx)
 {
     memset(rx, 0, sizeof *rx);
+    io_uplink_init(&rx->uplink);
     rx->last_gps_t = rx->last_ahrs_t = rx->last_air_t = -1;
 }
 
@@ -137,6 +138,46 @@ static int pilot(io_rx_t *rx, const struct canbus_rec *r)
     return rc;
 }
 
+/* The mission uplink: plan segments and the pilot's mission commands. */
+static int mission(io_rx_t *rx, const struct canbus_rec *r)
+{
+    int rc;
+    if (r->id == RPAS_CAN_MISSION_UPLOAD_FRAME_ID) {
+        struct rpas_can_mission_upload_t m;
+        if ((rc = rpas_can_mission_upload_unpack(&m, r->data, r->len)) == 0) {
+            int ev = io_uplink_segment(&rx->uplink, m.mup_seg, m.mup_cnt, m.mup_data);
+            if (ev != IO_UPLINK_NONE)
+                rx->uplink_event = ev;
+        }
+        return rc;
+    }
+    struct rpas_can_mission_cmd_t m;
+    if ((rc = rpas_can_mission_cmd_unpack(&m, r->data, r->len)) == 0) {
+        rx->mm_cmd.cmd = m.mc_cmd;
+        rx->mm_cmd.leg = m.mc_leg;
+        rx->mm_cmd.cmd_seq = m.mc_cnt;
+    }
+    return rc;
+}
+
+static int traffic(io_rx_t *rx, const struct canbus_rec *r)
+{
+    struct rpas_can_traffic_t m;
+    int rc = rpas_can_traffic_unpack(&m, r->data, r->len);
+    if (rc == 0) {
+        rpas_traffic_msg_t *t = &rx->traffic;
+        t->t_ns = r->t_ns;
+        t->seq = m.tfc_cnt;
+        t->valid = m.tfc_valid;
+        t->dn_m = rpas_can_traffic_tfc_dn_decode(m.tfc_dn);
+        t->de_m = rpas_can_traffic_tfc_de_decode(m.tfc_de);
+        t->dalt_ft = rpas_can_traffic_tfc_dalt_decode(m.tfc_dalt);
+        t->trk_deg = rpas_can_traffic_tfc_trk_decode(m.tfc_trk);
+        rx->traffic_new = true;
+    }
+    return rc;
+}
+
 static int act_status(io_rx_t *rx, const struct canbus_rec *r)
 {
     struct rpas_can_act_status_t m;
@@ -181,6 +222,13 @@ void io_rx_frame(io_rx_t *rx, io_peers_t *peers, unsigned n_nodes, const struct 
     case RPAS_CAN_ACT_STATUS_FRAME_ID:
         rc = act_status(rx, r);
         break;
+    case RPAS_CAN_MISSION_UPLOAD_FRAME_ID:
+    case RPAS_CAN_MISSION_CMD_FRAME_ID:
+        rc = mission(rx, r);
+        break;
+    case RPAS_CAN_TRAFFIC_FRAME_ID:
+        rc = traffic(rx, r);
+        break;
     default:
         if (r->id >= RPAS_CAN_ACT_CMD_A_FRAME_ID && r->id < RPAS_CAN_ACT_CMD_A_FRAME_ID + XCH_MAX_NODES) {
             unsigned ch = r->id - RPAS_CAN_ACT_CMD_A_FRAME_ID;
@@ -212,4 +260,6 @@ void io_rx_written(io_rx_t *rx)
     if (rx->air_new)
         rx->last_air_t = rx->air.t_ns;
     rx->gps_new = rx->ahrs_new = rx->air_new = rx->pilot_new = rx->act_new = false;
+    rx->traffic_new = false;
+    rx->uplink_event = IO_UPLINK_NONE;
 }

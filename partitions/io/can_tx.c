@@ -90,6 +90,20 @@ int io_tx_frames(const io_outputs_t *o, unsigned channel, uint32_t frame,
         put(&out[n++], RPAS_CAN_NAV_DATA_A_FRAME_ID, channel, buf,
             rpas_can_nav_data_a_pack(buf, &md, sizeof buf));
     }
+    if (frame % IO_NAV_EVERY == 0 && o->have_mm) {
+        const rpas_mm_status_msg_t *mm = &o->mm;
+        struct rpas_can_mission_status_a_t ms = {
+            .ms_state_a = (uint8_t)(mm->state & 0xF),
+            .ms_ct_a = (uint8_t)(mm->contingency < 15 ? mm->contingency : 15),
+            .ms_leg_a = (uint8_t)(mm->leg >= 0 && mm->leg < 255 ? mm->leg : 255),
+            .ms_xte_a = rpas_can_mission_status_a_ms_xte_a_encode(clampd(mm->xte_m, -3276.8, 3276.7)),
+            .ms_togo_a = rpas_can_mission_status_a_ms_togo_a_encode(clampd(mm->to_go_m, 0, 65535)),
+            .ms_phase_a = (uint8_t)(mm->phase & 0xF),
+            .ms_ct_flags_a = (uint8_t)(mm->ct_flags & 0xFF),
+            .ms_cnt_a = (uint8_t)((frame / IO_NAV_EVERY) & 0xF)};
+        put(&out[n++], RPAS_CAN_MISSION_STATUS_A_FRAME_ID, channel, buf,
+            rpas_can_mission_status_a_pack(buf, &ms, sizeof buf));
+    }
     return n;
 }
 

@@ -49,6 +49,39 @@ const char *io_axis_name(int axis); /* "elev", "ail", "rud", "thr" */
 /* The command's axes with their ranges (the DBC's), as the faults name them. */
 extern const fi_wo_axis_t io_axes[IO_AXES];
 
+/* ---- the mission plan's uplink (uplink.c) ------------------------------------------------ */
+
+#include "rpas/mission_plan.h"
+
+enum io_uplink_event {
+    IO_UPLINK_NONE = 0,
+    IO_UPLINK_STARTED,    /* an upload announced */
+    IO_UPLINK_COMPLETE,   /* a plan came whole and its CRC holds: plan_new */
+    IO_UPLINK_BAD_CRC,    /* a plan came whole and its CRC fails: dropped */
+    IO_UPLINK_BAD_HEADER, /* an announcement with an impossible length */
+};
+
+typedef struct {
+    bool receiving;
+    unsigned cnt;        /* the upload being received (MUP_CNT) */
+    uint32_t len, crc;   /* as announced */
+    unsigned got;        /* segments received */
+    uint8_t have[(RPAS_PLAN_MAX_BYTES + 6 * 8 - 1) / (6 * 8)];
+    uint8_t buf[RPAS_PLAN_MAX_BYTES];
+    /* the last plan received whole with a good CRC */
+    uint8_t plan[RPAS_PLAN_MAX_BYTES];
+    uint32_t plan_len, plan_crc;
+    bool plan_new; /* to be sent to the mission manager */
+    uint64_t refused;
+} io_uplink_t;
+
+void io_uplink_init(io_uplink_t *u);
+/* One MISSION_UPLOAD frame's segment: enum io_uplink_event. */
+int io_uplink_segment(io_uplink_t *u, unsigned seg, unsigned cnt, uint64_t data);
+/* The plan every member holds, from the agreed inputs of a frame (previous: the agreement so
+ * far, kept while a member is not heard or the members differ). */
+uint32_t io_plan_agreement(const struct xch_agreed *ag, uint32_t members, uint32_t previous);
+
 /* ---- CAN receive (can_rx.c) -------------------------------------------------------------- */
 
 /* The samples decoded from the frames of a major frame; `*_new`: to be written to the port. */
@@ -58,8 +91,12 @@ typedef struct {
     rpas_air_msg_t air;
     rpas_pilot_msg_t pilot;
     rpas_act_status_msg_t act;
+    rpas_mm_cmd_msg_t mm_cmd;   /* the pilot's last mission command (plan_crc: io fills in) */
+    rpas_traffic_msg_t traffic;
+    io_uplink_t uplink;
+    int uplink_event;           /* enum io_uplink_event of the frame, the last that is not NONE */
     bool gps_pos; /* GPS_POS came: GPS_VEL completes the sample */
-    bool gps_new, ahrs_new, air_new, pilot_new, act_new;
+    bool gps_new, ahrs_new, air_new, pilot_new, act_new, traffic_new;
     /* the time stamps of the samples last written to the ports (-1: none yet) */
     int64_t last_gps_t, last_ahrs_t, last_air_t;
     uint64_t decode_errors, unknown_frames;
@@ -82,7 +119,7 @@ void io_rx_written(io_rx_t *rx);
 
 /* ---- CAN transmit (can_tx.c) ------------------------------------------------------------- */
 
-#define IO_TX_MAX_FRAMES 4
+#define IO_TX_MAX_FRAMES 5
 #define IO_NAV_EVERY 2 /* NAV_POS / NAV_DATA every other major frame (10 Hz) */
 
 typedef struct {
@@ -93,10 +130,11 @@ typedef struct {
 
 /* nav_fcs's outputs of a frame, as read from io's destination ports. */
 typedef struct {
-    bool have_cmd, have_status, have_nav;
+    bool have_cmd, have_status, have_nav, have_mm;
     rpas_act_cmd_msg_t cmd;
     rpas_fcs_status_msg_t status;
     rpas_nav_msg_t nav;
+    rpas_mm_status_msg_t mm; /* the mission manager's status */
 } io_outputs_t;
 
 /* ---- faults (faults.c) ------------------------------------------------------------------- */
@@ -120,7 +158,7 @@ void io_cmd_faults(const io_settings_t *s, io_fault_state_t *st, int64_t t_ns,
 
 /* ---- CAN transmit, continued ----------------------------------------------------------- */
 /* The frames of major frame `frame` on redundancy channel `channel`: ACT_CMD_x, FCS_STATUS_x,
- * and every IO_NAV_EVERY frames NAV_POS_x and NAV_DATA_x. Values are clamped to the DBC's
+ * and every IO_NAV_EVERY frames NAV_POS_x, NAV_DATA_x and MISSION_STATUS_x. Values are clamped to the DBC's
  * ranges (NaN to the neutral value in range). `sent_cmd` gets the command as the others
  * decode it (when have_cmd). Returns the number of frames in out. */
 int io_tx_frames(const io_outputs_t *o, unsigned channel, uint32_t frame,
@@ -148,6 +186,7 @@ typedef struct {
     int64_t frame_ns, max_age_ns[3];
     uint64_t refused_stamps[XCH_MAX_NODES];
     uint32_t refused_new; /* nodes with a sample refused since the caller last looked */
+    uint32_t plan_agreed; /* the plan every member holds (0: none yet) */
     struct xch_mission last_mission;
     uint32_t last_mission_frame;
     bool mission_sent;

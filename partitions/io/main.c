@@ -35,7 +35,7 @@ static struct {
     uint32_t last_fcs_mode; /* for the node's health on DDS */
     io_fault_state_t faults; /* its --fault arguments, in their spells */
     io_fault_reports_t fault_reports;
-    SAMPLING_PORT_ID_TYPE port[IO_PORT_COUNT];
+    long port[IO_PORT_COUNT]; /* SAMPLING_PORT_ID_TYPE or QUEUING_PORT_ID_TYPE, by the port */
 } io;
 
 static int64_t now_ns(void)
@@ -94,7 +94,8 @@ static void xch_send(uint16_t type, int64_t t, const void *p, size_t len)
 static void write_port(int p, const void *msg, size_t len)
 {
     RETURN_CODE_TYPE rc;
-    WRITE_SAMPLING_MESSAGE(io.port[p], (MESSAGE_ADDR_TYPE)msg, (MESSAGE_SIZE_TYPE)len, &rc);
+    WRITE_SAMPLING_MESSAGE((SAMPLING_PORT_ID_TYPE)io.port[p], (MESSAGE_ADDR_TYPE)msg,
+                           (MESSAGE_SIZE_TYPE)len, &rc);
 }
 
 /* Reads a sampling port; true if a valid message of the port's size is there. */
@@ -103,7 +104,8 @@ static bool read_port(int p, void *msg)
     MESSAGE_SIZE_TYPE n = 0;
     VALIDITY_TYPE valid = INVALID;
     RETURN_CODE_TYPE rc;
-    READ_SAMPLING_MESSAGE(io.port[p], (MESSAGE_ADDR_TYPE)msg, &n, &valid, &rc);
+    READ_SAMPLING_MESSAGE((SAMPLING_PORT_ID_TYPE)io.port[p], (MESSAGE_ADDR_TYPE)msg, &n, &valid,
+                          &rc);
     return rc == NO_ERROR && valid == VALID && n == io_port_spec[p].size;
 }
 
@@ -164,6 +166,7 @@ static void exchange_inputs(int64_t t)
     struct xch_inputs mine;
     io_inputs(&io.rx, &mine);
     mine.wait_mask = io.red.members;
+    mine.plan_crc = io.rx.uplink.plan_crc;
     struct xch_agreed ag;
     int rc = xch_client_exchange(&io.xch, io.frame_no, t, &mine, &ag);
     if (rc != 0) {
@@ -172,10 +175,44 @@ static void exchange_inputs(int64_t t)
         return;
     }
     io_apply_agreed(&io.red, &io.rx, &ag, t);
+    uint32_t plan = io_plan_agreement(&ag, io.red.members, io.red.plan_agreed);
+    if (plan != io.red.plan_agreed)
+        rpas_report("io: mission plan 0x%08x held by every member", (unsigned)plan);
+    io.red.plan_agreed = plan;
     report_refused_stamps();
     struct xch_health h;
     io_health(&io.red, io.last_fcs_mode, &h);
     xch_send(XCH_HEALTH, t, &h, sizeof h);
+}
+
+/* The mission plan: a plan that came whole goes to the mission manager (its CRC, its
+ * length, the image); the plan agreement and the pilot's mission command, every frame. */
+static void mission_uplink(int64_t t)
+{
+    io_uplink_t *u = &io.rx.uplink;
+    static const char *const what[] = {
+        [IO_UPLINK_STARTED] = "upload started", [IO_UPLINK_COMPLETE] = "received",
+        [IO_UPLINK_BAD_CRC] = "refused: CRC mismatch, the plan held is kept",
+        [IO_UPLINK_BAD_HEADER] = "refused: bad length"};
+    if (io.rx.uplink_event != IO_UPLINK_NONE)
+        rpas_report("io: mission plan 0x%08x (%u bytes) %s", (unsigned)u->crc, (unsigned)u->len,
+                    what[io.rx.uplink_event]);
+    if (u->plan_new) {
+        static uint8_t msg[8 + RPAS_PLAN_MAX_BYTES];
+        memcpy(msg, &u->plan_crc, 4);
+        memcpy(msg + 4, &u->plan_len, 4);
+        memcpy(msg + 8, u->plan, u->plan_len);
+        RETURN_CODE_TYPE rc;
+        SEND_QUEUING_MESSAGE((QUEUING_PORT_ID_TYPE)io.port[IO_PORT_PLAN_OUT], (MESSAGE_ADDR_TYPE)msg,
+                             (MESSAGE_SIZE_TYPE)(8 + u->plan_len), 0, &rc);
+        u->plan_new = false;
+        if (!io.xch_on) /* one node: the plan it holds is the system's */
+            io.red.plan_agreed = u->plan_crc;
+    }
+    rpas_mm_cmd_msg_t c = io.rx.mm_cmd;
+    c.t_ns = t;
+    c.plan_crc = io.red.plan_agreed;
+    write_port(IO_PORT_MM_CMD_OUT, &c, sizeof c);
 }
 
 /* Writes the samples that came (or were agreed) this frame to their ports. */
@@ -196,6 +233,9 @@ static void write_samples(int64_t t)
     }
     if (rx->act_new)
         write_port(IO_PORT_ACT_OUT, &rx->act, sizeof rx->act);
+    if (rx->traffic_new)
+        write_port(IO_PORT_TRAFFIC_OUT, &rx->traffic, sizeof rx->traffic);
+    mission_uplink(t);
     io_rx_written(rx);
 }
 
@@ -232,6 +272,7 @@ static void tx_process(void)
             o.have_cmd = read_port(IO_PORT_ACT_CMD_IN, &o.cmd);
             o.have_status = read_port(IO_PORT_FCS_STATUS_IN, &o.status);
             o.have_nav = read_port(IO_PORT_NAV_IN, &o.nav);
+            o.have_mm = read_port(IO_PORT_MM_STATUS_IN, &o.mm);
             io_cmd_faults(&io.cfg, &io.faults, t, o.have_cmd ? &o.cmd : NULL, &io.fault_reports);
             for (unsigned i = 0; i < io.fault_reports.n; i++)
                 rpas_report("%s", io.fault_reports.line[i]);
@@ -296,7 +337,16 @@ int main(int argc, char *argv[])
     RETURN_CODE_TYPE rc;
     for (int p = 0; p < IO_PORT_COUNT; p++) {
         const rpas_port_spec_t *s = &io_port_spec[p];
-        CREATE_SAMPLING_PORT((char *)s->name, s->size, s->direction, s->refresh_ns, &io.port[p], &rc);
+        if (s->kind == RPAS_PORT_QUEUING) {
+            QUEUING_PORT_ID_TYPE id;
+            CREATE_QUEUING_PORT((char *)s->name, s->size, s->max_nb_messages, s->direction, FIFO,
+                                &id, &rc);
+            io.port[p] = id;
+        } else {
+            SAMPLING_PORT_ID_TYPE id;
+            CREATE_SAMPLING_PORT((char *)s->name, s->size, s->direction, s->refresh_ns, &id, &rc);
+            io.port[p] = id;
+        }
         if (rc != NO_ERROR)
             return fail(s->name, rc);
     }

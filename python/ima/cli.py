@@ -11,11 +11,11 @@ import traceback
 from collections.abc import Sequence
 
 from ima import __version__
-from ima.commands import bench, campaign, demo, deploy, fdr, fly, launch, run, test, trace
+from ima.commands import bench, campaign, demo, deploy, fdr, fly, launch, mission, run, test, trace
 from ima.errors import ImaError
 
 # Registration is explicit: a new subcommand is added here, never discovered by a scan.
-COMMANDS = [run, fly, demo, launch, campaign, fdr, trace, test, bench, deploy]
+COMMANDS = [run, fly, demo, launch, campaign, fdr, trace, test, bench, deploy, mission]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -7,6 +7,7 @@ import argparse
 import math
 import signal
 import sys
+from pathlib import Path
 
 from ima.errors import ImaError
 
@@ -62,6 +63,9 @@ def build_parser() -> argparse.ArgumentParser:
                     metavar="NAME",
                     help="TEST ONLY: no-vote-out makes the actuators' voter never vote a "
                     "channel out (to show that a campaign oracle can fail)")
+    ap.add_argument("--uplink", action="append", default=[], metavar="T:FILE",
+                    help="uplink the mission plan image FILE (`ima mission` compiles one) over "
+                    "the C2 link at T seconds; repeatable (a later plan replaces the earlier)")
     ap.add_argument("--status", action="store_true",
                     help="print one JSON progress line per emulated second on stdout")
     ap.add_argument("--name", default="world", help="client name on the bus")
@@ -131,6 +135,32 @@ def fault_options(args) -> list:
     return specs
 
 
+def uplink_options(args) -> list[tuple[int, bytes]]:
+    """The --uplink plans: [(t_ns, image)]; ImaError (exit 2, one line) when one is bad."""
+    from .config import NS
+    from .uplink import MAX_IMAGE
+
+    out = []
+    for text in args.uplink:
+        t, sep, path = text.partition(":")
+        try:
+            t_s = float(t)
+        except ValueError:
+            t_s = math.nan
+        if not sep or not 0 <= t_s < math.inf:
+            raise ImaError(f"--uplink {text!r}: expected T:FILE, T seconds >= 0", exit_code=2)
+        try:
+            image = Path(path).read_bytes()
+        except OSError as e:
+            raise ImaError(f"--uplink {text!r}: cannot read {path}: {e.strerror}",
+                           exit_code=2) from e
+        if not 0 < len(image) <= MAX_IMAGE:
+            raise ImaError(f"--uplink {text!r}: {len(image)} bytes is no plan image",
+                           exit_code=2)
+        out.append((round(t_s * NS), image))
+    return out
+
+
 def run(args) -> int:
     from ima.canbus import proto
     from ima.canbus.client import BusClient
@@ -144,11 +174,13 @@ def run(args) -> int:
         raise ImaError("--wind must not be negative", exit_code=2)
     voting = vote_options(args)
     faults = fault_options(args)
+    uploads = uplink_options(args)
     status_out = quiet_stdout()  # JSBSim prints to stdout; only --status lines may go there
     opts = Options(seed=args.seed, turbulence=args.turbulence or script.turbulence or "none",
                    wind_kt=args.wind, wind_from_deg=args.wind_from,
                    terrain_ft=args.terrain_ft, status=args.status, faults=faults,
-                   test_switches=tuple(dict.fromkeys(args.test_switch)), **voting)
+                   test_switches=tuple(dict.fromkeys(args.test_switch)), uploads=uploads,
+                   **voting)
     if script.start["altitude_ft"] - opts.terrain_ft < 200:
         raise ImaError(f"{args.pilot}: start.altitude_ft {script.start['altitude_ft']} is less "
                        f"than 200 ft above the terrain ({opts.terrain_ft} ft)", exit_code=2)

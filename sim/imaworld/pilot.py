@@ -49,6 +49,25 @@ SCHEMA = {
             },
         },
         "turbulence": {"enum": ["none", "light", "moderate"]},
+        # scripted intruders, reported by the surveillance receiver (traffic.py)
+        "traffic": {
+            "type": "array",
+            "items": {
+                "type": "object",
+                "additionalProperties": False,
+                "required": ["t", "bearing_deg", "range_m", "track_deg", "gs_kt"],
+                "properties": {
+                    "name": {"type": "string", "pattern": "^[A-Za-z0-9_-]{1,15}$"},
+                    "t": {"type": "number", "minimum": 0},
+                    "until": {"type": "number", "minimum": 0},
+                    "bearing_deg": {"type": "number", "minimum": 0, "maximum": 360},
+                    "range_m": {"type": "number", "exclusiveMinimum": 0, "maximum": 50000},
+                    "rel_alt_ft": {"type": "number", "minimum": -5000, "maximum": 5000},
+                    "track_deg": {"type": "number", "minimum": 0, "maximum": 360},
+                    "gs_kt": {"type": "number", "minimum": 0, "maximum": 500},
+                },
+            },
+        },
         # the remote pilot model flies DIRECT when the script does not (pilot_model.py)
         "pilot_model": {"type": "boolean"},
         "events": {
@@ -75,6 +94,13 @@ SCHEMA = {
                         },
                     },
                     "c2_link": {"enum": ["up", "down"]},
+                    # a mission command the station uplinks (the mission manager acts on it)
+                    "mission": {"oneOf": [
+                        {"enum": ["engage", "pause", "resume"]},
+                        {"type": "object", "additionalProperties": False,
+                         "required": ["direct_to"],
+                         "properties": {"direct_to": {"type": "integer", "minimum": 0,
+                                                      "maximum": 254}}}]},
                     "gps": {"enum": ["ok", "lost", "frozen"]},
                     "wind": {"$ref": "#/properties/wind"},
                 },
@@ -118,7 +144,13 @@ class PilotScript:
     duration_s: float | None = None
     description: str = ""
     pilot_model: bool = True
+    traffic: list[dict] = field(default_factory=list)
     initial: dict = field(default_factory=dict)
+
+    @property
+    def has_mission(self) -> bool:
+        """The script sends mission commands."""
+        return any("mission" in e for e in self.events)
 
     def __post_init__(self) -> None:
         s = self.start
@@ -135,7 +167,7 @@ class PilotScript:
         """The station state after one event (fields not in the event are kept)."""
         new = dict(state)
         for k, v in event.items():
-            if k == "t":
+            if k in ("t", "mission"):  # a mission command is an instant, not a state
                 continue
             if k == "stick":
                 new["stick"] = {**state["stick"], **v}
@@ -224,7 +256,7 @@ def parse(doc, path: str = "<script>") -> PilotScript:
         settle_s=(doc.get("evaluate") or {}).get("settle_s"),
         wind=doc.get("wind"), turbulence=doc.get("turbulence"),
         duration_s=doc.get("duration_s"), description=doc.get("description", ""),
-        pilot_model=doc.get("pilot_model", True))
+        pilot_model=doc.get("pilot_model", True), traffic=list(doc.get("traffic") or []))
 
 
 def load(path: str | Path) -> PilotScript:

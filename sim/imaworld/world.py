@@ -22,6 +22,8 @@ from .fdm import Aircraft
 from .pilot import LAT_MODE_CODES, MODE_CODES, VERT_MODE_CODES, PilotScript
 from .pilot_model import PilotModel
 from .sensors import Ahrs, AirData, Gps, cas_from_impact, static_pressure
+from .traffic import Traffic
+from .uplink import Uplink
 
 FLUSH_EVERY_NS = NS // 2  # emulated time between two flushes of the world's traces
 
@@ -64,6 +66,8 @@ class Options:
     # Test-only switches (--test-switch): "no-vote-out" makes the voter never vote a
     # channel out, to show that a campaign oracle can fail.
     test_switches: tuple[str, ...] = ()
+    # Mission plan images the station uplinks (--uplink T:FILE): [(t_ns, image)]
+    uploads: list[tuple[int, bytes]] = field(default_factory=list)
 
 
 def _r(x: float, n: int) -> float | None:
@@ -117,6 +121,10 @@ class World:
         self.fcs_status: list[tuple[int, int, int] | None] = [None, None, None]  # (t, mode, fb)
         self.fcs_last: tuple[int, int] | None = None
         self.pilot_model = PilotModel(params.pilot_model, script.pilot_model)
+        self.uplink = Uplink(opts.uploads) if opts.uploads or script.has_mission else None
+        self._uplink_ev_done = 0
+        self.traffic = Traffic(script.traffic) if script.traffic else None
+        self._traffic_ev_done = 0
         self._pm_done = 0
         self._stick_scripted = False  # the script flies the stick itself (see _scripted)
         # bookkeeping
@@ -208,7 +216,17 @@ class World:
             "c2_link": "up" if self.link_up() else "down", "gps": self.gps.effective_state,
             "wind_n_kt": _r(g["wind_n"]() / 1.6878098571011957, 3),
             "wind_e_kt": _r(g["wind_e"]() / 1.6878098571011957, 3),
+            **self._traffic_truth(),
         }
+
+    def _traffic_truth(self) -> dict:
+        """With scripted traffic: the separation from the nearest intruder (None: none yet)."""
+        if self.traffic is None:
+            return {}
+        n, e = self._own_ne()
+        near = self.traffic.nearest_m(self.t_now, n, e, self.ac.get["alt"]())
+        return {"traffic_h_m": _r(near[0], 1) if near else None,
+                "traffic_v_ft": _r(near[1], 1) if near else None}
 
     # -- periodic work -------------------------------------------------------------------
     def _make_tasks(self) -> list[list]:
@@ -224,6 +242,10 @@ class World:
             [0, p.station.stick_period_ms * ms, self._uplink_stick],
             [0, p.truth_period_ms * ms, self._truth],
         ]
+        if self.uplink is not None:
+            tasks.append([0, self.uplink.p.gap_ms * ms, self._uplink_plan])
+        if self.traffic is not None:
+            tasks.append([0, self.traffic.p.period_ms * ms, self._traffic])
         if self.status_out is not None:
             tasks.append([0, NS, self._status])
         if self.faults is not None:
@@ -246,6 +268,8 @@ class World:
                 self._stick_scripted = False
             if "stick" in e:
                 self._stick_scripted = True
+            if "mission" in e and self.uplink is not None:
+                self.uplink.command(t, e["mission"])
             fields = {k: v for k, v in e.items() if k != "t"}
             self.event("pilot", "pilot_event", **fields)
             if self.station["c2_link"] != old["c2_link"]:
@@ -294,6 +318,33 @@ class World:
             (_PILOT_TARGETS.frame_id, _PILOT_TARGETS.encode(
                 st["heading_deg"] % 360.0, st["altitude_ft"], st["airspeed_kt"], st["vs_fpm"])),
         ])
+        if self.uplink is not None:
+            self._send(t, [self.uplink.command_frame()])
+
+    def _own_ne(self) -> tuple[float, float]:
+        """The aircraft's position in metres north and east of the script's start."""
+        g, s = self.ac.get, self.script.start
+        k = math.radians(1.0) * 6371008.8
+        return ((g["lat"]() - s["lat_deg"]) * k,
+                ((g["lon"]() - s["lon_deg"] + 180.0) % 360.0 - 180.0) * k
+                * math.cos(math.radians(s["lat_deg"])))
+
+    def _traffic(self, t: int) -> None:
+        n, e = self._own_ne()
+        self._send(t, [self.traffic.sample(t, n, e, self.ac.get["alt"]())])
+        for te, kind, f in self.traffic.events[self._traffic_ev_done:]:
+            self.event("traffic", kind, t_ns=te, **f)
+        self._traffic_ev_done = len(self.traffic.events)
+
+    def _uplink_plan(self, t: int) -> None:
+        up = self.uplink
+        corrupt = (lambda _t: self.faults.uplink_corrupt) if self.faults else (lambda _t: False)
+        frames = up.due(t, self.link_up(), corrupt)
+        if frames:
+            self._send(t, frames)
+        for te, kind, f in up.events[self._uplink_ev_done:]:
+            self.event("station", kind, t_ns=te, **f)
+        self._uplink_ev_done = len(up.events)
 
     def _scripted(self) -> bool:
         """The script flies the stick itself: it asks for DIRECT and has given a stick input

@@ -119,21 +119,29 @@ def test_generate_result(triplex: DeployResult) -> None:
     out = triplex.out_dir
     assert triplex.modules == {n: out / f"{n}.xml" for n in ("node1", "node2", "node3")}
     assert triplex.glue == [out / "glue" / "io_ports.h", out / "glue" / "nav_fcs_ports.h",
-                            out / "glue" / "fdr_ports.h", out / "glue" / "rpas_system.h"]
+                            out / "glue" / "fdr_ports.h", out / "glue" / "mission_manager_ports.h",
+                            out / "glue" / "rpas_system.h"]
     json.dumps(triplex.summary)  # JSON-able
     s = triplex.summary
     assert [(p["name"], p["node"]) for p in s["partitions"]] == [
-        (p, n) for n in ("node1", "node2", "node3") for p in ("io", "nav_fcs", "fdr")]
+        (p, n) for n in ("node1", "node2", "node3")
+        for p in ("io", "nav_fcs", "fdr", "mission_manager")]
     io_ = s["partitions"][0]
     assert io_ == {**io_, "personality": "apex-c", "rate_hz": 20.0, "processes": ["rx", "tx"],
-                   "inputs": ["ACT_CMD_IN", "FCS_STATUS_IN", "NAV_IN"],
-                   "outputs": ["GPS_OUT", "AHRS_OUT", "AIR_OUT", "PILOT_OUT", "ACT_OUT"],
+                   "inputs": ["ACT_CMD_IN", "FCS_STATUS_IN", "NAV_IN", "MM_STATUS_IN"],
+                   "outputs": ["GPS_OUT", "AHRS_OUT", "AIR_OUT", "PILOT_OUT", "ACT_OUT",
+                               "PLAN_OUT", "MM_CMD_OUT", "TRAFFIC_OUT"],
                    "criticality": "LEVEL_A", "replicated": False, "system_partition": True}
     assert s["partitions"][1]["replicated"] is True
     fdr = s["partitions"][2]
     assert fdr == {**fdr, "criticality": "LEVEL_E", "replicated": False,
                    "inputs": ["NAV_IN", "FCS_STATUS_IN", "MISSION_IN", "HM_LOG_IN"], "outputs": []}
-    assert s["channels"] == {"intra_node": 8, "can_messages": 22, "dds_topics": 4}
+    mm = s["partitions"][3]
+    assert mm == {**mm, "criticality": "LEVEL_B", "replicated": False,
+                  "inputs": ["NAV_IN", "FCS_STATUS_IN", "PILOT_IN", "MM_CMD_IN", "TRAFFIC_IN",
+                             "PLAN_IN"],
+                  "outputs": ["MISSION_OUT", "MM_STATUS_OUT"]}
+    assert s["channels"] == {"intra_node": 13, "can_messages": 28, "dds_topics": 4}
     assert s["total_lines"] == sum(n for _, n in triplex.files)
 
 
@@ -143,7 +151,8 @@ def test_each_replica_sends_on_its_own_redundancy_channel(triplex: DeployResult)
             continue
         letter = {"node1": "A", "node2": "B", "node3": "C"}[p["node"]]
         assert p["can_sends"] == [f"ACT_CMD_{letter}", f"FCS_STATUS_{letter}",
-                                  f"NAV_POS_{letter}", f"NAV_DATA_{letter}"]
+                                  f"NAV_POS_{letter}", f"NAV_DATA_{letter}",
+                                  f"MISSION_STATUS_{letter}"]
         # Every node hears every node's heartbeat (membership).
         assert {"FCS_STATUS_A", "FCS_STATUS_B", "FCS_STATUS_C"} <= set(p["can_receives"])
 
@@ -179,9 +188,9 @@ def test_simplex_deploys_one_module(tmp_path: Path) -> None:
     result = generate(load_system(SIMPLEX), tmp_path)
     assert list(result.modules) == ["node1"]
     assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*") if p.is_file()) \
-        == ["glue/fdr_ports.h", "glue/io_ports.h", "glue/nav_fcs_ports.h", "glue/rpas_system.h",
-            "node1.xml"]
-    assert result.summary["channels"] == {"intra_node": 8, "can_messages": 14, "dds_topics": 4}
+        == ["glue/fdr_ports.h", "glue/io_ports.h", "glue/mission_manager_ports.h",
+            "glue/nav_fcs_ports.h", "glue/rpas_system.h", "node1.xml"]
+    assert result.summary["channels"] == {"intra_node": 13, "can_messages": 18, "dds_topics": 4}
     assert "#define RPAS_NODE_COUNT      1" in (tmp_path / "glue" / "rpas_system.h").read_text()
 
 
@@ -364,7 +373,7 @@ def test_a_partition_can_use_the_glue_with_apex(triplex: DeployResult, tmp_path:
         "static const int channels[RPAS_NODE_COUNT] = RPAS_NODE_CHANNELS;\n"
         "_Static_assert(IO_PORT_GPS_OUT_SIZE == NAV_FCS_PORT_GPS_IN_SIZE, \"channel ends\");\n"
         "_Static_assert(IO_PORT_GPS_OUT_CHANNEL_ID == NAV_FCS_PORT_GPS_IN_CHANNEL_ID, \"id\");\n"
-        "_Static_assert(NAV_FCS_PORT_MISSION_IN_CHANNEL_ID == 0, \"unconnected\");\n"
+        "_Static_assert(NAV_FCS_PORT_MISSION_IN_CHANNEL_ID != 0, \"connected\");\n"
         "_Static_assert(RPAS_MAJOR_FRAME_NS % IO_PARTITION_PERIOD_NS == 0, \"period\");\n"
         "void use(void) {\n"
         "    SAMPLING_PORT_ID_TYPE id; RETURN_CODE_TYPE rc;\n"
@@ -422,14 +431,15 @@ def test_command_prints_the_summary(tmp_path: Path, capsys) -> None:
     header = out.splitlines()[2].split()
     assert header == ["Partition", "Node", "Guest", "Rate", "Processes", "Inputs", "Outputs",
                       "Criticality", "Replicated"]
-    rows = [line.split() for line in out.splitlines()[3:12]]
+    rows = [line.split() for line in out.splitlines()[3:15]]
     assert [r[:4] for r in rows] == [[p, n, "apex-c", "20"] for n in ("node1", "node2", "node3")
-                                     for p in ("io", "nav_fcs", "fdr")]
-    assert [r[-1] for r in rows] == ["no", "yes", "no"] * 3
-    assert "Channels: 8 intra-node per node, 22 CAN messages, 4 DDS topics" in out
-    assert "Generated 7 files, " in out
+                                     for p in ("io", "nav_fcs", "fdr", "mission_manager")]
+    assert [r[-1] for r in rows] == ["no", "yes", "no", "no"] * 3
+    assert "Channels: 13 intra-node per node, 28 CAN messages, 4 DDS topics" in out
+    assert "Generated 8 files, " in out
     for name in ("node1.xml", "node2.xml", "node3.xml", "glue/io_ports.h",
-                 "glue/nav_fcs_ports.h", "glue/fdr_ports.h", "glue/rpas_system.h"):
+                 "glue/nav_fcs_ports.h", "glue/fdr_ports.h", "glue/mission_manager_ports.h",
+                 "glue/rpas_system.h"):
         assert name in out
     assert (tmp_path / "node3.xml").is_file()
 
@@ -442,10 +452,10 @@ def test_command_json(tmp_path: Path, capsys) -> None:
     assert out.count("\n") == 1
     summary = json.loads(out)
     assert summary["system"] == "rpas_triplex"
-    assert summary["channels"] == {"intra_node": 8, "can_messages": 22, "dds_topics": 4}
+    assert summary["channels"] == {"intra_node": 13, "can_messages": 28, "dds_topics": 4}
     assert [f["path"] for f in summary["files"]] == [
         "node1.xml", "node2.xml", "node3.xml", "glue/io_ports.h", "glue/nav_fcs_ports.h",
-        "glue/fdr_ports.h", "glue/rpas_system.h"]
+        "glue/fdr_ports.h", "glue/mission_manager_ports.h", "glue/rpas_system.h"]
 
 
 def test_summary_on_a_terminal_is_a_table(triplex: DeployResult) -> None:

@@ -130,7 +130,7 @@ def test_a_queuing_port_needs_a_capacity(tmp_path, good) -> None:
     msg, _ = refuse(tmp_path, good,
                     lambda d: d["partitions"][0]["ports"].append(
                         {"name": "Q", "direction": "source", "kind": "queuing", "size": 8}))
-    assert msg.endswith(": partitions[0].ports[8]: 'max_messages' is a required property"), msg
+    assert msg.endswith(": partitions[0].ports[12]: 'max_messages' is a required property"), msg
 
 
 def test_several_errors_are_listed_with_their_lines(tmp_path, good) -> None:
@@ -255,14 +255,15 @@ SEMANTIC_CASES = [
      lambda d: d["partitions"][0]["ports"].append(
          {"name": "Q", "direction": "source", "kind": "queuing", "size": 8, "max_messages": 4,
           "refresh_s": 0.1}),
-     "partitions[0].ports[8].refresh_s: only a sampling port has a refresh period",
+     "partitions[0].ports[12].refresh_s: only a sampling port has a refresh period",
      "refresh_s: 0.1"),
     ("unknown channel port",
      lambda d: d["channels"]["intra_node"][0].update({"from": "io.GPS_OUTX"}),
      "channels.intra_node[0].from: partition 'io' has no port named 'GPS_OUTX' (its ports: "
      "GPS_OUT, ", "io.GPS_OUTX"),
     ("unknown channel partition", lambda d: d["channels"]["intra_node"][1].update(to="nav.AHRS_IN"),
-     "channels.intra_node[1].to: no partition named 'nav' (partitions: io, nav_fcs, fdr)",
+     "channels.intra_node[1].to: no partition named 'nav' "
+     "(partitions: io, nav_fcs, fdr, mission_manager)",
      "nav.AHRS_IN"),
     ("source is a destination port",
      lambda d: d["channels"]["intra_node"][0].update({"from": "nav_fcs.MISSION_IN"}),
@@ -298,7 +299,8 @@ SEMANTIC_CASES = [
      "schedule.major_frame_s: 0.0500000001 is not a whole number of nanoseconds",
      "major_frame_s"),
     ("replicated partition unknown", lambda d: d.update(replicated=["fcs"]),
-     "replicated[0]: no partition named 'fcs' (partitions: io, nav_fcs, fdr)", "- fcs"),
+     "replicated[0]: no partition named 'fcs' (partitions: io, nav_fcs, fdr, mission_manager)",
+     "- fcs"),
     ("process level during initialisation",
      lambda d: d["health_monitoring"]["system"]["PARTITION_INIT"].update(
          NUMERIC_ERROR="PROCESS"),
@@ -307,11 +309,11 @@ SEMANTIC_CASES = [
      "NUMERIC_ERROR: PROCESS"),
     ("unknown CAN message",
      lambda d: d["channels"]["can"]["partitions"]["io"]["receives"].append("GPS_SPEED"),
-     "channels.can.partitions.io.receives[11]: 'GPS_SPEED' (node1) is not a message of rpas.dbc",
+     "channels.can.partitions.io.receives[14]: 'GPS_SPEED' (node1) is not a message of rpas.dbc",
      "GPS_SPEED"),
     ("sending on every channel",
      lambda d: d["channels"]["can"]["partitions"]["io"]["sends"].append("NAV_POS_{channels}"),
-     "channels.can.partitions.io.sends[4]: 'NAV_POS_{channels}': a node sends on its own "
+     "channels.can.partitions.io.sends[5]: 'NAV_POS_{channels}': a node sends on its own "
      "redundancy channel only: use {channel}", "NAV_POS_{channels}"),
     ("CAN traffic of an unknown partition",
      lambda d: d["channels"]["can"]["partitions"].update(mm={"sends": ["GPS_POS"]}),

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import yaml
 
+from ima.campaign.systems import drop_partition
+
 ROOT = Path(__file__).resolve().parents[2]
 PILOTS = ROOT / "sim" / "pilots"
 
@@ -45,9 +47,10 @@ def scratch_system(dest: Path, edit, nodes: int = 1) -> Path:
 
 
 def mission_system(dest: Path, feed_args: list[str]) -> Path:
-    """The one-node system plus a stand-in mission manager (partition mission_feed) writing
-    MISSION targets to nav_fcs in the free part of the major frame."""
+    """The one-node system with a stand-in mission manager (partition mission_feed) writing
+    fixed MISSION targets to nav_fcs, in place of the mission manager."""
     def add_feed(app: dict) -> None:
+        drop_partition(app, "mission_manager")
         app["partitions"].append({
             "name": "mission_feed", "criticality": "LEVEL_C", "personality": "apex-c",
             "executable": "mission_feed", "arguments": list(feed_args), "period_s": 0.05,
@@ -58,7 +61,8 @@ def mission_system(dest: Path, feed_args: list[str]) -> Path:
         app["schedule"]["windows"].append(
             {"partition": "mission_feed", "start_s": 0.03, "duration_s": 0.005})
         app["channels"]["intra_node"].append(
-            {"name": "mission", "from": "mission_feed.MISSION_OUT", "to": "nav_fcs.MISSION_IN"})
+            {"name": "mission", "from": "mission_feed.MISSION_OUT",
+             "to": ["nav_fcs.MISSION_IN", "fdr.MISSION_IN"]})
     return scratch_system(dest, add_feed)
 
 

@@ -78,7 +78,8 @@ struct xch_inputs {
     uint32_t gps_seq, gps_fix, gps_sats;
     uint32_t ahrs_seq, ahrs_status;
     uint32_t air_seq, air_status;
-    uint32_t pad;
+    uint32_t plan_crc; /* the CRC-32 of the mission plan this node holds (0: none): a plan is
+                          activated once every member holds the same (partitions/io/uplink.c) */
     double gps[5];  /* lat_deg, lon_deg, alt_ft, gs_kt, trk_deg */
     double ahrs[9]; /* roll, pitch, hdg (deg); p, q, r (deg/s); ax, ay, az (g) */
     double air[3];  /* ias_kt, alt_ft, vs_fpm */

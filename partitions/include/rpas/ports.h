@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The RPAS application's intra-node port messages: what the io partition, nav_fcs and (later)
- * the mission manager exchange through sampling ports. Engineering units, doubles, each
+/* The RPAS application's intra-node port messages: what the io partition, nav_fcs and the
+ * mission manager exchange through sampling ports. Engineering units, doubles, each
  * message stamped with the emulated time its data was taken (the end of the CAN frame it came
  * from, or the time the producing partition computed it). Port names, sizes and the struct each
  * port carries are in the system model (config/applications/rpas.yaml), from which the build
@@ -99,7 +99,7 @@ typedef struct {
     double tgt_hdg_deg, tgt_alt_ft, tgt_ias_kt, tgt_vs_fpm;
 } rpas_fcs_status_msg_t;
 
-/* nav_fcs -> io (and later the mission manager): port NAV_OUT, the navigation solution */
+/* nav_fcs -> io, the recorder and the mission manager: port NAV_OUT, the navigation solution */
 #define RPAS_NAV_GPS 0x1
 #define RPAS_NAV_AHRS 0x2
 #define RPAS_NAV_AIR 0x4
@@ -114,12 +114,75 @@ typedef struct {
     double wind_n_kt, wind_e_kt; /* wind estimate: where the air moves to */
 } rpas_nav_msg_t;
 
+/* The mission manager's state (rpas_mm_status_msg_t.state, MISSION_STATUS_x.MM_STATE). */
+enum rpas_mm_state {
+    RPAS_MM_NO_PLAN = 0,     /* no plan yet: no targets */
+    RPAS_MM_STANDBY = 1,     /* a plan, the flight control not in MISSION yet: targets, no sequencing */
+    RPAS_MM_ACTIVE = 2,      /* flying the plan's legs */
+    RPAS_MM_PAUSED = 3,      /* the pilot paused: holding where it was */
+    RPAS_MM_CONTINGENCY = 4, /* a contingency's procedure preempts the plan */
+    RPAS_MM_COMPLETE = 5,    /* the last leg is done: orbiting its end (or stopped, after a landing) */
+    RPAS_MM_TERMINATED = 6,  /* flight termination: the defined safe state */
+};
+
+/* The pilot's mission commands (MISSION_CMD.MC_CMD). */
+enum rpas_mm_cmd {
+    RPAS_MMC_NONE = 0,
+    RPAS_MMC_ENGAGE = 1,    /* fly the plan from its first leg */
+    RPAS_MMC_PAUSE = 2,     /* hold where it is */
+    RPAS_MMC_RESUME = 3,    /* back to the leg it paused on */
+    RPAS_MMC_DIRECT_TO = 4, /* direct to leg `leg`'s fix, then on from there */
+};
+
+/* io -> mission manager: port MM_CMD_IN (each major frame) */
+typedef struct {
+    int64_t t_ns;
+    uint32_t plan_crc; /* the plan every member node holds (agreed over DDS; 0: none agreed) */
+    uint32_t cmd_seq;  /* the pilot's command counter: a new value is a new command */
+    uint32_t cmd;      /* enum rpas_mm_cmd */
+    uint32_t leg;      /* DIRECT_TO: the leg */
+} rpas_mm_cmd_msg_t;
+
+/* io -> mission manager: port TRAFFIC_IN (the surveillance receiver's nearest intruder,
+ * relative to the aircraft) */
+typedef struct {
+    int64_t t_ns;
+    uint32_t seq;
+    uint32_t valid; /* 1: an intruder is reported */
+    double dn_m, de_m; /* where it is: north and east of the aircraft */
+    double dalt_ft;    /* its altitude minus the aircraft's */
+    double trk_deg;    /* its track */
+    double pad;
+} rpas_traffic_msg_t;
+
+/* mission manager -> io (downlink) and the recorder: port MM_STATUS_OUT */
+typedef struct {
+    int64_t t_ns;
+    uint32_t state;       /* enum rpas_mm_state */
+    uint32_t contingency; /* the contingency in force (enum rpas_contingency), 255 none */
+    uint32_t ct_flags;    /* bit k: contingency k's condition is declared */
+    uint32_t plan_id, plan_crc;
+    int32_t leg;          /* the active leg, -1 none */
+    uint32_t leg_type;    /* enum rpas_leg_type */
+    uint32_t phase;
+    double to_go_m;       /* distance to go on the leg */
+    double xte_m;         /* cross-track error, + right of the path */
+    double alt_ref_ft;    /* the vertical path's altitude now */
+} rpas_mm_status_msg_t;
+
+/* rpas_mission_msg_t.flags: the phases of an automatic landing and flight termination, in
+ * which nav_fcs flies outside its usual envelope. */
+#define RPAS_MSN_APPROACH 0x1  /* final approach: airspeed targets down to the approach speed */
+#define RPAS_MSN_FLARE 0x2     /* flare: throttle to idle, the vertical speed flown by pitch */
+#define RPAS_MSN_ROLLOUT 0x4   /* on the runway: idle, wheel brakes, steer the centre line */
+#define RPAS_MSN_TERMINATE 0x8 /* flight termination: engine cut, wings level */
+
 /* mission manager -> nav_fcs: port MISSION_IN (targets for MISSION / CONTINGENCY) */
 typedef struct {
     int64_t t_ns;
     uint32_t mode; /* RPAS_MODE_MISSION or RPAS_MODE_CONTINGENCY */
     uint32_t lat_mode, vert_mode;
-    uint32_t pad;
+    uint32_t flags; /* RPAS_MSN_* */
     double hdg_deg; /* heading or track, by lat_mode */
     double alt_ft, ias_kt, vs_fpm;
 } rpas_mission_msg_t;

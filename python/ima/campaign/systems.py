@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The system a MISSION workload flies until the mission manager exists: the campaign's system
-model with the stand-in mission feed (partition `mission_feed`, partitions/testing/) writing
-MISSION targets to nav_fcs in the free part of the major frame. Written into the campaign
-folder, generated from the model (never edited), so the one source of truth stays the model."""
+"""The system a MISSION workload flies: the campaign's system model with the stand-in mission
+feed (partition `mission_feed`, partitions/testing/) in place of the mission manager, writing
+fixed MISSION targets to nav_fcs (a workload flies no plan). Written into the campaign folder,
+generated from the model (never edited), so the one source of truth stays the model."""
 
 from __future__ import annotations
 
@@ -23,12 +23,30 @@ def _absolute(doc: dict, base_of) -> None:
             ch[section][key] = str((base_of("channels") / ch[section][key]).resolve())
 
 
+def drop_partition(doc: dict, name: str) -> None:
+    """Removes partition `name` from a system or application document: the partition, its
+    windows, and its ends of the intra-node channels (a channel left with no end goes too)."""
+    doc["partitions"] = [p for p in doc["partitions"] if p["name"] != name]
+    doc["schedule"] = dict(doc["schedule"], windows=[
+        w for w in doc["schedule"]["windows"] if w["partition"] != name])
+    kept = []
+    for ch in doc["channels"].get("intra_node") or []:
+        if ch["from"].split(".")[0] == name:
+            continue
+        to = ch["to"] if isinstance(ch["to"], list) else [ch["to"]]
+        to = [t for t in to if t.split(".")[0] != name]
+        if to:
+            kept.append(dict(ch, to=to if len(to) > 1 else to[0]))
+    doc["channels"] = dict(doc["channels"], intra_node=kept)
+
+
 def with_mission_feed(system: Path, dest: Path, feed: dict) -> Path:
     """dest: the system with the mission feed (feed: heading_deg, altitude_ft, airspeed_kt,
     silent_after_s)."""
     source = read_source(Path(system))
     doc = dict(source.doc)
     _absolute(doc, source.base)
+    drop_partition(doc, "mission_manager")
     silent = feed.get("silent_after_s", 1e6)
     doc["partitions"] = list(doc["partitions"]) + [{
         "name": "mission_feed", "criticality": "LEVEL_C", "personality": "apex-c",

@@ -31,6 +31,7 @@ class CrossChannelInputs(IdlStruct, typename="rpas::CrossChannelInputs"):
     ahrs_status: uint32 = 0
     air_seq: uint32 = 0
     air_status: uint32 = 0
+    plan_crc: uint32 = 0
     gps: array[float64, 5] = field(default_factory=lambda: [0.0] * 5)
     ahrs: array[float64, 9] = field(default_factory=lambda: [0.0] * 9)
     air: array[float64, 3] = field(default_factory=lambda: [0.0] * 3)

@@ -41,7 +41,7 @@ INPUTS_FIELDS = [
     ("gps_seq", "I"), ("gps_fix", "I"), ("gps_sats", "I"),
     ("ahrs_seq", "I"), ("ahrs_status", "I"),
     ("air_seq", "I"), ("air_status", "I"),
-    ("pad", "I"),
+    ("plan_crc", "I"),
     ("gps", "5d"), ("ahrs", "9d"), ("air", "3d"),
 ]
 HEALTH_FIELDS = [("membership", "I"), ("flags", "I"), ("fcs_mode", "I"), ("failed", "I"),
@@ -96,6 +96,7 @@ class Inputs:
     ahrs_status: int = 0
     air_seq: int = 0
     air_status: int = 0
+    plan_crc: int = 0
     gps: list[float] = field(default_factory=lambda: [0.0] * 5)
     ahrs: list[float] = field(default_factory=lambda: [0.0] * 9)
     air: list[float] = field(default_factory=lambda: [0.0] * 3)
@@ -103,13 +104,13 @@ class Inputs:
     def pack(self) -> bytes:
         return INPUTS_S.pack(self.valid, self.wait_mask, self.gps_t_ns, self.ahrs_t_ns,
                              self.air_t_ns, self.gps_seq, self.gps_fix, self.gps_sats,
-                             self.ahrs_seq, self.ahrs_status, self.air_seq, self.air_status, 0,
+                             self.ahrs_seq, self.ahrs_status, self.air_seq, self.air_status, self.plan_crc,
                              *self.gps, *self.ahrs, *self.air)
 
     @classmethod
     def unpack(cls, data: bytes) -> Inputs:
         v = INPUTS_S.unpack(data)
-        return cls(*v[:12], gps=list(v[13:18]), ahrs=list(v[18:27]), air=list(v[27:30]))
+        return cls(*v[:13], gps=list(v[13:18]), ahrs=list(v[18:27]), air=list(v[27:30]))
 
 
 @dataclass

@@ -25,7 +25,7 @@ NAV = struct.Struct("<qII12d")
 STATUS_FIELDS = ("t_ns", "mode", "req_mode", "fallback", "nav_flags", "env_flags", "lat_mode",
                  "vert_mode", "pad", "tgt_hdg_deg", "tgt_alt_ft", "tgt_ias_kt", "tgt_vs_fpm")
 STATUS = struct.Struct("<q8I4d")
-MISSION_FIELDS = ("t_ns", "mode", "lat_mode", "vert_mode", "pad", "hdg_deg", "alt_ft", "ias_kt",
+MISSION_FIELDS = ("t_ns", "mode", "lat_mode", "vert_mode", "flags", "hdg_deg", "alt_ft", "ias_kt",
                   "vs_fpm")
 MISSION = struct.Struct("<q4I4d")
 FRAME_HEAD = struct.Struct("<II")  # frame, valid

@@ -15,7 +15,7 @@ from ima import paths
 from ima.deploy import System
 from ima.deploy.model import VOTING_AXES, canbus_socket_name, dds_socket_name
 from ima.errors import ImaError
-from ima.launch.options import LaunchOptions, binary
+from ima.launch.options import MISSION_UPLINK_S, LaunchOptions, binary
 
 
 @dataclass
@@ -77,6 +77,8 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
                   "--vote-persist", str(int(v["persist"])),
                   "--vote-offset", f"{float(v['offset_s']):g}",
                   "--vote-period", f"{system.major_frame_s:g}"]
+    if opts.mission is not None:
+        world += ["--uplink", f"{MISSION_UPLINK_S:g}:{run_dir / 'mission.img'}"]
     world += faults.world
     switches = test_switches(opts.test_switches, names)
     world += switches.get("world", [])

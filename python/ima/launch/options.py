@@ -26,7 +26,9 @@ class LaunchOptions:
     system: Path
     duration_s: float = 600.0
     seed: int = 1
-    pilot: Path | None = None  # default: sim/pilots/default.yaml
+    pilot: Path | None = None  # default: sim/pilots/default.yaml (fly_mission.yaml with a mission)
+    # a mission plan (config/missions/*.yaml): uplinked over C2 at MISSION_UPLINK_S and flown
+    mission: Path | None = None
     turbulence: str = "light"
     wind_kt: float = 10.0
     wind_from_deg: float = 270.0
@@ -73,8 +75,15 @@ class LaunchRun:
     plan: object = None  # faultinject.plan.Plan of the run's faults (None without faults)
 
 
-def default_pilot() -> Path:
-    return paths.repo_root() / "sim" / "pilots" / "default.yaml"
+# When the station uplinks the mission plan: every node is up and flying by then.
+MISSION_UPLINK_S = 2.0
+
+
+def default_pilot(mission: bool = False) -> Path:
+    """The remote pilot's script: the autopilot's, or with a mission plan the one that hands
+    the aircraft to the mission manager."""
+    name = "fly_mission.yaml" if mission else "default.yaml"
+    return paths.repo_root() / "sim" / "pilots" / name
 
 
 def system_path(name: str) -> Path:

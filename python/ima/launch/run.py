@@ -68,12 +68,20 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None,
     names = [n.name for n in system.nodes]
     if opts.netns and os.geteuid() != 0:
         raise ImaError("--netns needs root (it creates network namespaces)")
-    pilot = Path(opts.pilot) if opts.pilot else default_pilot()
+    pilot = Path(opts.pilot) if opts.pilot else default_pilot(opts.mission is not None)
     pilot_script.load(pilot)  # a bad script is reported before anything starts
+    image = None
+    if opts.mission is not None:  # a bad plan too
+        from ima.mission import image as plan_image
+        from ima.mission import plan as mission_plan
+
+        image = plan_image.encode(mission_plan.load(opts.mission))
 
     run_dir = Path(opts.run_dir) if opts.run_dir else new_run_dir(opts.kind, opts.seed)
     outdir.usable_dir(run_dir, "run directory")
     run_dir = run_dir.resolve()  # the nodes run in the socket directory: paths are absolute
+    if image is not None:
+        (run_dir / "mission.img").write_bytes(image)
     plan = fault_plan.prepare(opts, system, run_dir, launch)
     kills, hangs = plan.kills, plan.hangs
     both = sorted(set(kills) & set(hangs))
@@ -117,6 +125,7 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
     (run_dir / "launch.json").write_text(json.dumps({
         "kind": opts.kind, "system": str(system.path), "nodes": names, "seed": opts.seed,
         "duration_s": opts.duration_s, "pilot": str(pilot), "turbulence": opts.turbulence,
+        "mission": str(Path(opts.mission).resolve()) if opts.mission else None,
         "wind_kt": opts.wind_kt, "wind_from_deg": opts.wind_from_deg, "realtime": opts.realtime,
         "host_cpus": len(os.sched_getaffinity(0)), "quantum_us": opts.quantum_us,
         "dds_domain": domain,

@@ -52,7 +52,11 @@ enum io_port {
     IO_PORT_ACT_CMD_IN = 5,
     IO_PORT_FCS_STATUS_IN = 6,
     IO_PORT_NAV_IN = 7,
-    IO_PORT_COUNT = 8
+    IO_PORT_PLAN_OUT = 8,
+    IO_PORT_MM_CMD_OUT = 9,
+    IO_PORT_TRAFFIC_OUT = 10,
+    IO_PORT_MM_STATUS_IN = 11,
+    IO_PORT_COUNT = 12
 };
 
 /* GPS_OUT: sampling source, channel 1 'gps' to nav_fcs.GPS_IN */
@@ -91,7 +95,7 @@ RPAS_GLUE_CHECK(sizeof(rpas_ahrs_msg_t) == IO_PORT_AHRS_OUT_SIZE,
 RPAS_GLUE_CHECK(sizeof(rpas_air_msg_t) == IO_PORT_AIR_OUT_SIZE,
     "io.AIR_OUT: sizeof(rpas_air_msg_t) differs from the port size in the model (40)");
 
-/* PILOT_OUT: sampling source, channel 4 'pilot' to nav_fcs.PILOT_IN */
+/* PILOT_OUT: sampling source, channel 4 'pilot' to nav_fcs.PILOT_IN, mission_manager.PILOT_IN */
 #define IO_PORT_PILOT_OUT_NAME         "PILOT_OUT"
 #define IO_PORT_PILOT_OUT_KIND         RPAS_PORT_SAMPLING
 #define IO_PORT_PILOT_OUT_DIRECTION    SOURCE /* PORT_DIRECTION_TYPE */
@@ -151,6 +155,51 @@ RPAS_GLUE_CHECK(sizeof(rpas_fcs_status_msg_t) == IO_PORT_FCS_STATUS_IN_SIZE,
 RPAS_GLUE_CHECK(sizeof(rpas_nav_msg_t) == IO_PORT_NAV_IN_SIZE,
     "io.NAV_IN: sizeof(rpas_nav_msg_t) differs from the port size in the model (112)");
 
+/* PLAN_OUT: queuing source, channel 9 'mission_plan' to mission_manager.PLAN_IN */
+#define IO_PORT_PLAN_OUT_NAME            "PLAN_OUT"
+#define IO_PORT_PLAN_OUT_KIND            RPAS_PORT_QUEUING
+#define IO_PORT_PLAN_OUT_DIRECTION       SOURCE /* PORT_DIRECTION_TYPE */
+#define IO_PORT_PLAN_OUT_SIZE            2512 /* MaxMessageSize, bytes */
+#define IO_PORT_PLAN_OUT_MAX_NB_MESSAGES 2
+#define IO_PORT_PLAN_OUT_CHANNEL_ID      9
+#define IO_PORT_PLAN_OUT_CHANNEL_NAME    "mission_plan"
+
+/* MM_CMD_OUT: sampling source, channel 10 'mission_commands' to mission_manager.MM_CMD_IN */
+#define IO_PORT_MM_CMD_OUT_NAME         "MM_CMD_OUT"
+#define IO_PORT_MM_CMD_OUT_KIND         RPAS_PORT_SAMPLING
+#define IO_PORT_MM_CMD_OUT_DIRECTION    SOURCE /* PORT_DIRECTION_TYPE */
+#define IO_PORT_MM_CMD_OUT_SIZE         24 /* MaxMessageSize, bytes */
+#define IO_PORT_MM_CMD_OUT_REFRESH_NS   200000000LL
+#define IO_PORT_MM_CMD_OUT_CHANNEL_ID   10
+#define IO_PORT_MM_CMD_OUT_CHANNEL_NAME "mission_commands"
+#define IO_PORT_MM_CMD_OUT_MESSAGE      rpas_mm_cmd_msg_t /* its messages' C type */
+RPAS_GLUE_CHECK(sizeof(rpas_mm_cmd_msg_t) == IO_PORT_MM_CMD_OUT_SIZE,
+    "io.MM_CMD_OUT: sizeof(rpas_mm_cmd_msg_t) differs from the port size in the model (24)");
+
+/* TRAFFIC_OUT: sampling source, channel 11 'traffic' to mission_manager.TRAFFIC_IN */
+#define IO_PORT_TRAFFIC_OUT_NAME         "TRAFFIC_OUT"
+#define IO_PORT_TRAFFIC_OUT_KIND         RPAS_PORT_SAMPLING
+#define IO_PORT_TRAFFIC_OUT_DIRECTION    SOURCE /* PORT_DIRECTION_TYPE */
+#define IO_PORT_TRAFFIC_OUT_SIZE         56 /* MaxMessageSize, bytes */
+#define IO_PORT_TRAFFIC_OUT_REFRESH_NS   1000000000LL
+#define IO_PORT_TRAFFIC_OUT_CHANNEL_ID   11
+#define IO_PORT_TRAFFIC_OUT_CHANNEL_NAME "traffic"
+#define IO_PORT_TRAFFIC_OUT_MESSAGE      rpas_traffic_msg_t /* its messages' C type */
+RPAS_GLUE_CHECK(sizeof(rpas_traffic_msg_t) == IO_PORT_TRAFFIC_OUT_SIZE,
+    "io.TRAFFIC_OUT: sizeof(rpas_traffic_msg_t) differs from the port size in the model (56)");
+
+/* MM_STATUS_IN: sampling destination, channel 13 'mission_status' from mission_manager.MM_STATUS_OUT */
+#define IO_PORT_MM_STATUS_IN_NAME         "MM_STATUS_IN"
+#define IO_PORT_MM_STATUS_IN_KIND         RPAS_PORT_SAMPLING
+#define IO_PORT_MM_STATUS_IN_DIRECTION    DESTINATION /* PORT_DIRECTION_TYPE */
+#define IO_PORT_MM_STATUS_IN_SIZE         64 /* MaxMessageSize, bytes */
+#define IO_PORT_MM_STATUS_IN_REFRESH_NS   200000000LL
+#define IO_PORT_MM_STATUS_IN_CHANNEL_ID   13
+#define IO_PORT_MM_STATUS_IN_CHANNEL_NAME "mission_status"
+#define IO_PORT_MM_STATUS_IN_MESSAGE      rpas_mm_status_msg_t /* its messages' C type */
+RPAS_GLUE_CHECK(sizeof(rpas_mm_status_msg_t) == IO_PORT_MM_STATUS_IN_SIZE,
+    "io.MM_STATUS_IN: sizeof(rpas_mm_status_msg_t) differs from the port size in the model (64)");
+
 /* The processes and ports in the order of their enums, for a partition that creates them
  * in a loop: {name, period, offset, stack, priority, deadline} and {name, kind,
  * direction, size, refresh period, queue capacity, channel}. */
@@ -167,12 +216,16 @@ static const rpas_port_spec_t io_port_spec[IO_PORT_COUNT] = {
     [IO_PORT_ACT_CMD_IN] = {"ACT_CMD_IN", RPAS_PORT_SAMPLING, DESTINATION, 48, 200000000LL, 0, 6},
     [IO_PORT_FCS_STATUS_IN] = {"FCS_STATUS_IN", RPAS_PORT_SAMPLING, DESTINATION, 72, 200000000LL, 0, 7},
     [IO_PORT_NAV_IN] = {"NAV_IN", RPAS_PORT_SAMPLING, DESTINATION, 112, 200000000LL, 0, 8},
+    [IO_PORT_PLAN_OUT] = {"PLAN_OUT", RPAS_PORT_QUEUING, SOURCE, 2512, 0LL, 2, 9},
+    [IO_PORT_MM_CMD_OUT] = {"MM_CMD_OUT", RPAS_PORT_SAMPLING, SOURCE, 24, 200000000LL, 0, 10},
+    [IO_PORT_TRAFFIC_OUT] = {"TRAFFIC_OUT", RPAS_PORT_SAMPLING, SOURCE, 56, 1000000000LL, 0, 11},
+    [IO_PORT_MM_STATUS_IN] = {"MM_STATUS_IN", RPAS_PORT_SAMPLING, DESTINATION, 64, 200000000LL, 0, 13},
 };
 
 /* Its traffic beyond the node, for reference:
- *   CAN on node1: sends ACT_CMD_A, FCS_STATUS_A, NAV_POS_A, NAV_DATA_A; receives GPS_POS, GPS_VEL, AHRS_ATT, AHRS_RATE, AHRS_ACCEL, AIR_DATA, ACT_STATUS, PILOT_MODE, PILOT_TARGETS, PILOT_STICK, FCS_STATUS_A, FCS_STATUS_B, FCS_STATUS_C
- *   CAN on node2: sends ACT_CMD_B, FCS_STATUS_B, NAV_POS_B, NAV_DATA_B; receives GPS_POS, GPS_VEL, AHRS_ATT, AHRS_RATE, AHRS_ACCEL, AIR_DATA, ACT_STATUS, PILOT_MODE, PILOT_TARGETS, PILOT_STICK, FCS_STATUS_A, FCS_STATUS_B, FCS_STATUS_C
- *   CAN on node3: sends ACT_CMD_C, FCS_STATUS_C, NAV_POS_C, NAV_DATA_C; receives GPS_POS, GPS_VEL, AHRS_ATT, AHRS_RATE, AHRS_ACCEL, AIR_DATA, ACT_STATUS, PILOT_MODE, PILOT_TARGETS, PILOT_STICK, FCS_STATUS_A, FCS_STATUS_B, FCS_STATUS_C
+ *   CAN on node1: sends ACT_CMD_A, FCS_STATUS_A, NAV_POS_A, NAV_DATA_A, MISSION_STATUS_A; receives GPS_POS, GPS_VEL, AHRS_ATT, AHRS_RATE, AHRS_ACCEL, AIR_DATA, ACT_STATUS, PILOT_MODE, PILOT_TARGETS, PILOT_STICK, MISSION_UPLOAD, MISSION_CMD, TRAFFIC, FCS_STATUS_A, FCS_STATUS_B, FCS_STATUS_C
+ *   CAN on node2: sends ACT_CMD_B, FCS_STATUS_B, NAV_POS_B, NAV_DATA_B, MISSION_STATUS_B; receives GPS_POS, GPS_VEL, AHRS_ATT, AHRS_RATE, AHRS_ACCEL, AIR_DATA, ACT_STATUS, PILOT_MODE, PILOT_TARGETS, PILOT_STICK, MISSION_UPLOAD, MISSION_CMD, TRAFFIC, FCS_STATUS_A, FCS_STATUS_B, FCS_STATUS_C
+ *   CAN on node3: sends ACT_CMD_C, FCS_STATUS_C, NAV_POS_C, NAV_DATA_C, MISSION_STATUS_C; receives GPS_POS, GPS_VEL, AHRS_ATT, AHRS_RATE, AHRS_ACCEL, AIR_DATA, ACT_STATUS, PILOT_MODE, PILOT_TARGETS, PILOT_STICK, MISSION_UPLOAD, MISSION_CMD, TRAFFIC, FCS_STATUS_A, FCS_STATUS_B, FCS_STATUS_C
  *   DDS topics, through the node's agent: rpas_CrossChannelInputs, rpas_NodeHealth, rpas_Telemetry, rpas_MissionData
  */
 

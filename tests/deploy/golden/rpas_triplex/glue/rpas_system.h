@@ -11,7 +11,7 @@
 #define RPAS_SYSTEM_NAME     "rpas_triplex"
 #define RPAS_MAJOR_FRAME_NS  50000000LL /* 0.05 s */
 #define RPAS_NODE_COUNT      3
-#define RPAS_PARTITION_COUNT 3 /* on every node */
+#define RPAS_PARTITION_COUNT 4 /* on every node */
 
 /* Per node, in the order of the system model: name, index (1..3), redundancy channel. */
 #define RPAS_NODE_NAMES    { "node1", "node2", "node3" }
@@ -28,9 +28,10 @@
 #define RPAS_NODE3_CHANNEL 2 /* redundancy channel C */
 
 /* Partition identifiers (the same on every node). */
-#define RPAS_PARTITION_IO_ID      1
-#define RPAS_PARTITION_NAV_FCS_ID 2 /* replicated */
-#define RPAS_PARTITION_FDR_ID     3
+#define RPAS_PARTITION_IO_ID              1
+#define RPAS_PARTITION_NAV_FCS_ID         2 /* replicated */
+#define RPAS_PARTITION_FDR_ID             3
+#define RPAS_PARTITION_MISSION_MANAGER_ID 4
 
 enum rpas_port_kind {
     RPAS_PORT_SAMPLING = 0,

@@ -178,6 +178,20 @@ static int traffic(io_rx_t *rx, const struct canbus_rec *r)
     return rc;
 }
 
+static int radalt(io_rx_t *rx, const struct canbus_rec *r)
+{
+    struct rpas_can_radalt_t m;
+    int rc = rpas_can_radalt_unpack(&m, r->data, r->len);
+    if (rc == 0) {
+        rx->radalt.t_ns = r->t_ns;
+        rx->radalt.seq = m.ra_cnt;
+        rx->radalt.valid = m.ra_stat;
+        rx->radalt.height_ft = rpas_can_radalt_ra_hgt_decode(m.ra_hgt);
+        rx->radalt_new = true;
+    }
+    return rc;
+}
+
 static int act_status(io_rx_t *rx, const struct canbus_rec *r)
 {
     struct rpas_can_act_status_t m;
@@ -229,6 +243,9 @@ void io_rx_frame(io_rx_t *rx, io_peers_t *peers, unsigned n_nodes, const struct 
     case RPAS_CAN_TRAFFIC_FRAME_ID:
         rc = traffic(rx, r);
         break;
+    case RPAS_CAN_RADALT_FRAME_ID:
+        rc = radalt(rx, r);
+        break;
     default:
         if (r->id >= RPAS_CAN_ACT_CMD_A_FRAME_ID && r->id < RPAS_CAN_ACT_CMD_A_FRAME_ID + XCH_MAX_NODES) {
             unsigned ch = r->id - RPAS_CAN_ACT_CMD_A_FRAME_ID;
@@ -260,6 +277,6 @@ void io_rx_written(io_rx_t *rx)
     if (rx->air_new)
         rx->last_air_t = rx->air.t_ns;
     rx->gps_new = rx->ahrs_new = rx->air_new = rx->pilot_new = rx->act_new = false;
-    rx->traffic_new = false;
+    rx->traffic_new = rx->radalt_new = false;
     rx->uplink_event = IO_UPLINK_NONE;
 }

@@ -55,6 +55,13 @@ int io_tx_frames(const io_outputs_t *o, unsigned channel, uint32_t frame,
         sent_cmd[1] = rpas_can_act_cmd_a_ail_cmd_a_decode(m.ail_cmd_a);
         sent_cmd[2] = rpas_can_act_cmd_a_rud_cmd_a_decode(m.rud_cmd_a);
         sent_cmd[3] = rpas_can_act_cmd_a_thr_cmd_a_decode(m.thr_cmd_a);
+        if (c->brake > 0.0f) { /* on the runway only: nothing is sent in flight */
+            struct rpas_can_brake_cmd_a_t b = {
+                .brk_cmd_a = rpas_can_brake_cmd_a_brk_cmd_a_encode(clampd(c->brake, 0, 1)),
+                .brk_cnt_a = (uint8_t)(c->seq & 0xF)};
+            put(&out[n++], RPAS_CAN_BRAKE_CMD_A_FRAME_ID, channel, buf,
+                rpas_can_brake_cmd_a_pack(buf, &b, sizeof buf));
+        }
     }
     if (o->have_status) {
         const rpas_fcs_status_msg_t *st = &o->status;

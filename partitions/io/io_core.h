@@ -93,10 +93,11 @@ typedef struct {
     rpas_act_status_msg_t act;
     rpas_mm_cmd_msg_t mm_cmd;   /* the pilot's last mission command (plan_crc: io fills in) */
     rpas_traffic_msg_t traffic;
+    rpas_radalt_msg_t radalt;
     io_uplink_t uplink;
     int uplink_event;           /* enum io_uplink_event of the frame, the last that is not NONE */
     bool gps_pos; /* GPS_POS came: GPS_VEL completes the sample */
-    bool gps_new, ahrs_new, air_new, pilot_new, act_new, traffic_new;
+    bool gps_new, ahrs_new, air_new, pilot_new, act_new, traffic_new, radalt_new;
     /* the time stamps of the samples last written to the ports (-1: none yet) */
     int64_t last_gps_t, last_ahrs_t, last_air_t;
     uint64_t decode_errors, unknown_frames;
@@ -119,7 +120,7 @@ void io_rx_written(io_rx_t *rx);
 
 /* ---- CAN transmit (can_tx.c) ------------------------------------------------------------- */
 
-#define IO_TX_MAX_FRAMES 5
+#define IO_TX_MAX_FRAMES 6
 #define IO_NAV_EVERY 2 /* NAV_POS / NAV_DATA every other major frame (10 Hz) */
 
 typedef struct {
@@ -158,7 +159,8 @@ void io_cmd_faults(const io_settings_t *s, io_fault_state_t *st, int64_t t_ns,
 
 /* ---- CAN transmit, continued ----------------------------------------------------------- */
 /* The frames of major frame `frame` on redundancy channel `channel`: ACT_CMD_x, FCS_STATUS_x,
- * and every IO_NAV_EVERY frames NAV_POS_x, NAV_DATA_x and MISSION_STATUS_x. Values are clamped to the DBC's
+ * BRAKE_CMD_x while nav_fcs brakes, and every IO_NAV_EVERY frames NAV_POS_x, NAV_DATA_x and
+ * MISSION_STATUS_x. Values are clamped to the DBC's
  * ranges (NaN to the neutral value in range). `sent_cmd` gets the command as the others
  * decode it (when have_cmd). Returns the number of frames in out. */
 int io_tx_frames(const io_outputs_t *o, unsigned channel, uint32_t frame,

@@ -235,6 +235,8 @@ static void write_samples(int64_t t)
         write_port(IO_PORT_ACT_OUT, &rx->act, sizeof rx->act);
     if (rx->traffic_new)
         write_port(IO_PORT_TRAFFIC_OUT, &rx->traffic, sizeof rx->traffic);
+    if (rx->radalt_new)
+        write_port(IO_PORT_RADALT_OUT, &rx->radalt, sizeof rx->radalt);
     mission_uplink(t);
     io_rx_written(rx);
 }

@@ -19,6 +19,7 @@ enum {
     P_PILOT = MISSION_MANAGER_PORT_PILOT_IN,
     P_CMD = MISSION_MANAGER_PORT_MM_CMD_IN,
     P_TRAFFIC = MISSION_MANAGER_PORT_TRAFFIC_IN,
+    P_RADALT = MISSION_MANAGER_PORT_RADALT_IN,
     P_PLAN = MISSION_MANAGER_PORT_PLAN_IN,
     P_MISSION = MISSION_MANAGER_PORT_MISSION_OUT,
     P_MM_STATUS = MISSION_MANAGER_PORT_MM_STATUS_OUT,
@@ -83,6 +84,7 @@ static void cycle(void)
         in->pilot_ok = read_port(P_PILOT, &in->pilot);
         in->cmd_ok = read_port(P_CMD, &in->cmd);
         in->traffic_ok = read_port(P_TRAFFIC, &in->traffic);
+        in->radalt_ok = read_port(P_RADALT, &in->radalt);
         in->plan = NULL;
         receive_plan();
 

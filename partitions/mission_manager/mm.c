@@ -285,6 +285,8 @@ static void activate(mm_t *mm, const mm_state_t *st)
              (unsigned)mm->plan.hdr.plan_id, (unsigned)mm->plan.hdr.n_legs, (unsigned)mm->plan.crc);
 }
 
+static void rejoin(mm_t *mm, int i, const mm_state_t *st);
+
 static void pilot_command(mm_t *mm, const rpas_mm_cmd_msg_t *c, const mm_state_t *st)
 {
     if (mm->state == RPAS_MM_NO_PLAN || mm->state == RPAS_MM_TERMINATED)
@@ -307,7 +309,7 @@ static void pilot_command(mm_t *mm, const rpas_mm_cmd_msg_t *c, const mm_state_t
     case RPAS_MMC_RESUME:
         if (mm->state == RPAS_MM_PAUSED) {
             mm->state = mm->engaged ? RPAS_MM_ACTIVE : RPAS_MM_STANDBY;
-            start_leg(mm, mm->resume_leg, st, false);
+            rejoin(mm, mm->resume_leg, st);
             EVENT("resumed at leg %d", mm->resume_leg);
         }
         break;
@@ -396,10 +398,7 @@ static void preempt(mm_t *mm, uint32_t c, const mm_state_t *st, const mm_inputs_
     mm->ct_clear_since = -1;
     mm->proc_started = false;
     mm->state = ct->action == RPAS_CTA_TERMINATE ? RPAS_MM_TERMINATED : RPAS_MM_CONTINGENCY;
-    if (ct->action == RPAS_CTA_HOLD) {
-        start_synth(mm, RPAS_LEG_ORBIT, st->pos, 0.0, mm->alt_ref_ft, st);
-        mm->proc_started = true;
-    } else if (ct->action == RPAS_CTA_AVOID) {
+    if (ct->action == RPAS_CTA_AVOID) {
         /* turn away from the intruder's side, climb or descend away from its altitude */
         mm_vec_t rel_p = {in->traffic.dn_m, in->traffic.de_m};
         double rel = nf_wrap180(mm_course((mm_vec_t){0.0, 0.0}, rel_p) - st->trk_deg);
@@ -412,18 +411,41 @@ static void preempt(mm_t *mm, uint32_t c, const mm_state_t *st, const mm_inputs_
     EVENT("contingency %s declared at leg %d", mm_ct_name(c), mm->resume_leg);
 }
 
+/* A procedure or hold begins once the mission has gone on for the plan's continue_s. */
 static void contingency_step(mm_t *mm, const mm_state_t *st)
 {
     const rpas_plan_contingency_t *ct = &mm->plan.hdr.contingency[mm->ct_active];
-    if (ct->action == RPAS_CTA_PROCEDURE && !mm->proc_started &&
-        age_s(st->t_ns, mm->ct_t0_ns) + 1e-9 >= ct->continue_s) {
+    bool later = ct->action == RPAS_CTA_PROCEDURE || ct->action == RPAS_CTA_HOLD;
+    if (later && !mm->proc_started && age_s(st->t_ns, mm->ct_t0_ns) + 1e-9 >= ct->continue_s) {
         mm->proc_started = true;
         if (!mm->flying_synth)
             mm->resume_leg = mm->ls.leg; /* the mission went on meanwhile */
+        if (ct->action == RPAS_CTA_HOLD) {
+            start_synth(mm, RPAS_LEG_ORBIT, st->pos, 0.0, mm->alt_ref_ft, st);
+            EVENT("contingency %s: procedure starts (mission leg %d left)",
+                  mm_ct_name(mm->ct_active), mm->resume_leg);
+            return;
+        }
         mm->proc_leg = ct->first_leg;
         EVENT("contingency %s: procedure starts (mission leg %d left)", mm_ct_name(mm->ct_active),
               mm->resume_leg);
         sequence_from(mm, mm->proc_leg, ct->first_leg + ct->n_legs, st, false);
+    }
+}
+
+/* Back to the mission at leg i, from wherever the aircraft is: a leg that ends at its fix
+ * (TF, DF, CF, RF) directly to that fix, then on; any other leg flown again from its start
+ * (holds, orbits, scans and landings join their own path). */
+static void rejoin(mm_t *mm, int i, const mm_state_t *st)
+{
+    const mm_leg_t *L = &mm->plan.leg[i];
+    int t = L->raw.type;
+    if (t == RPAS_LEG_TF || t == RPAS_LEG_DF || t == RPAS_LEG_CF || t == RPAS_LEG_RF) {
+        start_synth(mm, RPAS_LEG_DIRECT, L->fix, 0.0,
+                    isfinite(L->raw.alt_ft) ? L->raw.alt_ft : mm->alt_ref_ft, st);
+        mm->ls.leg = i;
+    } else {
+        start_leg(mm, i, st, false);
     }
 }
 
@@ -433,7 +455,7 @@ static void resume(mm_t *mm, const mm_state_t *st)
     uint32_t c = mm->ct_active;
     mm->ct_active = NONE_CT;
     mm->state = RPAS_MM_ACTIVE;
-    start_leg(mm, mm->resume_leg, st, false);
+    rejoin(mm, mm->resume_leg, st);
     EVENT("contingency %s cleared: mission resumes at leg %d", mm_ct_name(c), mm->resume_leg);
 }
 
@@ -477,6 +499,10 @@ static bool state_from_nav(const mm_t *mm, const mm_inputs_t *in, int64_t now, m
     st->vs_fpm = n->vs_fpm;
     st->tas_mps = nf_tas_from_ias(st->ias_kt, st->alt_ft) * NF_KT_MPS;
     st->wind_mps = hypot(n->wind_n_kt, n->wind_e_kt) * NF_KT_MPS;
+    st->wheels_agl_ft = in->radalt_ok && in->radalt.valid && isfinite(in->radalt.height_ft) &&
+                                age_s(now, in->radalt.t_ns) <= mm->prm.radalt_max_age_s
+                            ? in->radalt.height_ft
+                            : NAN;
     st->t_ns = now;
     return true;
 }

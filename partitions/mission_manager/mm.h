@@ -30,7 +30,13 @@
     X(cmd_max_age_s, 1.0, "io's plan-agreement message older than this is not used")         \
     X(traffic_max_age_s, 2.0, "a traffic report older than this is not used")                 \
     X(hold_default_leg_s, 60.0, "leg time of a hold made up in flight (pause, HOLD action)")  \
-    X(hold_rate_dps, 3.0, "turn rate of holds (standard rate), unless max_bank_deg is less")
+    X(hold_rate_dps, 3.0, "turn rate of holds (standard rate), unless max_bank_deg is less")  \
+    X(gear_ft, 4.4, "height of the altitude reference above the main wheels on the ground")   \
+    X(radalt_max_age_s, 0.3, "a radar altitude older than this is not used")                  \
+    X(flare_ft, 25.0, "wheel height at which the flare begins")                              \
+    X(flare_tau_s, 4.0, "the flare's time constant: the sink rate falls with the height")    \
+    X(flare_sink_fps, 1.5, "the sink rate the flare aims for at the ground")                 \
+    X(runway_xte_k, 1.0, "flare and roll-out: course correction per metre off the centre line")
 
 typedef struct {
 #define MM_PARAM_FIELD(name, value, meaning) double name;
@@ -105,12 +111,13 @@ bool mm_dubins(mm_vec_t p0, double crs0, mm_vec_t p1, double crs1, double r, mm_
 /* ---- inputs and outputs ------------------------------------------------------------------ */
 
 typedef struct {
-    bool nav_ok, fcs_ok, pilot_ok, cmd_ok, traffic_ok;
+    bool nav_ok, fcs_ok, pilot_ok, cmd_ok, traffic_ok, radalt_ok;
     rpas_nav_msg_t nav;
     rpas_fcs_status_msg_t fcs;
     rpas_pilot_msg_t pilot;
     rpas_mm_cmd_msg_t cmd;
     rpas_traffic_msg_t traffic;
+    rpas_radalt_msg_t radalt;
     /* a plan image that arrived this cycle (NULL: none) and its CRC as the uplink gave it */
     const void *plan;
     size_t plan_len;
@@ -169,6 +176,7 @@ typedef struct {
     mm_vec_t pos;
     double alt_ft, ias_kt, gs_mps, trk_deg, hdg_deg, vs_fpm;
     double tas_mps, wind_mps;
+    double wheels_agl_ft; /* the radar altimeter's height (NaN: none: from the altitude) */
     int64_t t_ns;
 } mm_state_t;
 
@@ -180,6 +188,7 @@ typedef struct {
     double vs_ff_fpm;   /* a geometric path's own vertical speed (0: none) */
     double ias_kt;
     double xte_m, to_go_m;
+    bool raw_vs;        /* the vertical speed as demanded (the flare): no energy balance */
 } mm_demand_t;
 
 /* Starts leg L (from the present state; alt_ref_ft: the altitude flown so far). */

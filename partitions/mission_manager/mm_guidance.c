@@ -46,7 +46,9 @@ void mm_guidance(const mm_params_t *prm, const rpas_plan_header_t *hdr, const mm
     double vs = d->vs_ff_fpm + prm->alt_kp * (d->alt_ft - st->alt_ft);
     /* energy balance: an airspeed deficit takes from the climb, an excess from the descent */
     double dv = ias - st->ias_kt;
-    if (dv > prm->energy_dead_kt && vs > -vs_max)
+    if (d->raw_vs)
+        ; /* the flare trades its speed away on purpose */
+    else if (dv > prm->energy_dead_kt && vs > -vs_max)
         vs -= prm->energy_kb * (dv - prm->energy_dead_kt);
     else if (dv < -prm->energy_dead_kt && vs < 0.0)
         vs = fmin(0.0, vs - prm->energy_kb * (dv + prm->energy_dead_kt));

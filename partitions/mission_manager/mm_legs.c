@@ -310,37 +310,37 @@ static void scan_step(mm_leg_state_t *ls, const mm_leg_t *L, const mm_state_t *s
 }
 
 /* The automatic landing: the final on the glide path to the aim point, the flare, the
- * roll-out on the centre line to a stop. Heights above the runway from the navigation
- * altitude (GPS-augmented on the approach). */
-static void land_step(mm_leg_state_t *ls, const mm_leg_t *L, const mm_state_t *st,
-                      const mm_track_t *tk, mm_demand_t *d)
+ * roll-out on the centre line to a stop. The height of the wheels from the radar altimeter
+ * when it reports, else from the navigation altitude. */
+static void land_step(mm_leg_state_t *ls, const mm_leg_t *L, const mm_params_t *prm,
+                      const mm_state_t *st, const mm_track_t *tk, mm_demand_t *d)
 {
     const rpas_plan_leg_t *r = &L->raw;
     double elev = r->alt_ft;
-    double hgt = st->alt_ft - elev;
+    double wheels = isfinite(st->wheels_agl_ft) ? st->wheels_agl_ft
+                                                : st->alt_ft - elev - prm->gear_ft;
     double gp = (r->a > 0.0f ? r->a : 3.0) * NF_DEG;
-    double to_aim = (tk->along_m - 20000.0) * -1.0 + r->b; /* along-track distance to the aim point */
-    double path = elev + to_aim * tan(gp) * FT_PER_M;
+    double to_aim = 20000.0 - tk->along_m + r->b; /* along the centre line to the aim point */
+    double path = elev + prm->gear_ft + to_aim * tan(gp) * FT_PER_M;
     d->ias_kt = isfinite(r->ias_kt) ? r->ias_kt : 65.0;
+    d->raw_vs = ls->phase != L_FINAL;
     switch (ls->phase) {
     case L_FINAL:
         /* below the glide path: level at the leg's start altitude until it is intercepted */
         d->alt_ft = fmin(path, fmax(ls->start_alt_ft, elev + 200.0));
         d->vs_ff_fpm = path <= ls->start_alt_ft ? -st->gs_mps * tan(gp) * FT_PER_M * 60.0 : 0.0;
-        if (hgt < 35.0 && to_aim < 1500.0)
+        if (wheels < prm->flare_ft && to_aim < 1500.0)
             phase(ls, L_FLARE, ls->seg, st);
         break;
     case L_FLARE:
+        /* the sink rate falls with the height: an exponential path onto the runway */
         d->alt_ft = st->alt_ft;
-        d->vs_ff_fpm = -(60.0 + 6.0 * fmax(hgt, 0.0));
-        d->ias_kt = 50.0;
-        if (hgt < 1.0)
+        d->vs_ff_fpm = -60.0 * (fmax(wheels, 0.0) / prm->flare_tau_s + prm->flare_sink_fps);
+        if (wheels < (isfinite(st->wheels_agl_ft) ? 0.5 : 1.0))
             phase(ls, L_ROLLOUT, ls->seg, st);
         break;
     case L_ROLLOUT:
         d->alt_ft = st->alt_ft;
-        d->vs_ff_fpm = 0.0;
-        d->ias_kt = 0.0;
         if (st->gs_mps < 0.5) {
             phase(ls, L_STOPPED, ls->seg, st);
             ls->done = true;
@@ -348,7 +348,6 @@ static void land_step(mm_leg_state_t *ls, const mm_leg_t *L, const mm_state_t *s
         break;
     default:
         d->alt_ft = st->alt_ft;
-        d->ias_kt = 0.0;
         break;
     }
 }
@@ -425,7 +424,7 @@ void mm_leg_step(mm_leg_state_t *ls, const mm_leg_t *L, const rpas_plan_header_t
         dubins_step(ls, L, st, &tk);
         break;
     case RPAS_LEG_AUTOLAND:
-        land_step(ls, L, st, &tk, d);
+        land_step(ls, L, prm, st, &tk, d);
         break;
     default:
         ls->done = true;
@@ -439,6 +438,9 @@ void mm_leg_step(mm_leg_state_t *ls, const mm_leg_t *L, const rpas_plan_header_t
         d->crs_deg = mm_lateral(prm, &ls->seg, &now, st->gs_mps);
         d->hdg = ls->seg.kind == MM_SEG_HDG;
     }
+    if (r->type == RPAS_LEG_AUTOLAND && ls->phase != L_FINAL && !ls->turning_in)
+        /* near and on the runway: the centre line held tightly, never more than 10 deg off */
+        d->crs_deg = nf_wrap360(ls->seg.crs - nf_clamp(prm->runway_xte_k * now.xte_m, -10.0, 10.0));
     d->xte_m = ls->seg.kind == MM_SEG_LINE || ls->seg.kind == MM_SEG_ARC ? now.xte_m : 0.0;
     d->to_go_m = ls->seg.kind == MM_SEG_LINE ? now.to_go_m : tk.to_go_m;
 

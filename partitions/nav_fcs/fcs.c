@@ -71,6 +71,7 @@ static fcs_targets_t sane_targets(const fcs_t *f, uint32_t lat, uint32_t vert, d
     t.alt = nf_clamp(finite_or(alt, f->tgt.alt), -1000.0, 20000.0);
     t.ias = nf_clamp(finite_or(ias, f->tgt.ias), p->ias_min, p->ias_max);
     t.vs = nf_clamp(finite_or(vs, f->tgt.vs), -p->vs_max, p->vs_max);
+    t.flags = 0;
     return t;
 }
 
@@ -155,6 +156,10 @@ static void select_mode(fcs_t *f, const fcs_inputs_t *in, const rpas_nav_msg_t *
             const rpas_mission_msg_t *m = &in->mission;
             mode = m->mode;
             t = sane_targets(f, m->lat_mode, m->vert_mode, m->hdg_deg, m->alt_ft, m->ias_kt, m->vs_fpm);
+            t.flags = m->flags & (RPAS_MSN_APPROACH | RPAS_MSN_FLARE | RPAS_MSN_ROLLOUT |
+                                  RPAS_MSN_TERMINATE);
+            if ((t.flags & (RPAS_MSN_APPROACH | RPAS_MSN_FLARE)) && isfinite(m->ias_kt))
+                t.ias = nf_clamp(m->ias_kt, f->prm.ias_min_land, f->prm.ias_max);
         } else {
             fb = RPAS_FB_MISSION_STALE;
             hold = true;
@@ -353,8 +358,11 @@ static void run_loops(fcs_t *f, const fcs_inputs_t *in, const rpas_nav_msg_t *na
     double e_vs = air ? f->vs_cmd - nav->vs_fpm : 0.0; /* no air data: feed-forward only */
     double th_raw = flight_path_deg(f->vs_cmd, tas) + p->vs_kp * e_vs + f->vs_i;
     bool spd_prot = false;
-    if (air && nav->ias_kt < p->prot_vmin) {
-        th_raw -= p->prot_spd_pitch * (p->prot_vmin - nav->ias_kt); /* nose down to regain speed */
+    /* on a final approach and in the flare the aircraft flies slower: a lower threshold */
+    bool landing = t->flags & (RPAS_MSN_APPROACH | RPAS_MSN_FLARE);
+    double vmin = landing ? p->prot_vmin_land : p->prot_vmin;
+    if (air && nav->ias_kt < vmin) {
+        th_raw -= p->prot_spd_pitch * (vmin - nav->ias_kt); /* nose down to regain speed */
         f->env_flags |= FCS_ENV_UNDERSPEED;
         spd_prot = true;
     } else if (air && nav->ias_kt > p->prot_vmax) {
@@ -390,7 +398,7 @@ static void run_loops(fcs_t *f, const fcs_inputs_t *in, const rpas_nav_msg_t *na
         thr = nf_clamp(thr_raw, p->thr_min, 1.0);
         f->thr_i = integrate(f->thr_i, p->thr_ki, e_v, dt, thr_raw >= 1.0, thr_raw <= p->thr_min,
                              -p->thr_i_max, p->thr_i_max);
-        if (nav->ias_kt < p->prot_vmin)
+        if (nav->ias_kt < vmin)
             thr = 1.0;
         else if (nav->ias_kt > p->prot_vmax)
             thr = p->thr_min;
@@ -398,11 +406,29 @@ static void run_loops(fcs_t *f, const fcs_inputs_t *in, const rpas_nav_msg_t *na
         f->ias_cmd = t->ias;
         thr = thr_feed_forward(p, t->ias, f->vs_cmd);
     }
+    /* the flare and flight termination: the engine at idle (cut), the pitch flies the path */
+    if (t->flags & (RPAS_MSN_FLARE | RPAS_MSN_TERMINATE)) {
+        thr = 0.0;
+        f->thr_i = 0.0;
+    }
 
     out[0] = -nu;
     out[1] = ail;
     out[2] = rud;
     out[3] = nf_clamp(thr, 0.0, 1.0);
+}
+
+/* The roll-out after a landing: engine idle, the elevator holding the nose wheel light, wings
+ * level, the nose wheel (the rudder) steering the runway's course, the brakes once slow. */
+static void run_rollout(fcs_t *f, const rpas_nav_msg_t *nav, double out[4])
+{
+    const fcs_params_t *p = &f->prm;
+    double err = nf_wrap180(f->tgt.hdg - nav->hdg_deg);
+    out[0] = p->rollout_elev;
+    out[1] = 0.0;
+    out[2] = nf_clamp(p->steer_k * err, -1.0, 1.0);
+    out[3] = 0.0;
+    f->brake = nav->gs_kt < p->brake_gs_kt ? p->brake_max : 0.0;
 }
 
 void fcs_step(fcs_t *f, const fcs_inputs_t *in, const rpas_nav_msg_t *nav, int64_t now_ns,
@@ -427,7 +453,11 @@ void fcs_step(fcs_t *f, const fcs_inputs_t *in, const rpas_nav_msg_t *nav, int64
                      act ? a->thr : f->thr};
 
     double out[4];
-    if (direct_ok) {
+    f->brake = 0.0;
+    if (!direct_ok && f->fallback == RPAS_FB_NONE && (f->tgt.flags & RPAS_MSN_ROLLOUT)) {
+        run_rollout(f, nav, out);
+        f->loops_active = false;
+    } else if (direct_ok) {
         run_direct(f, in, nav, dt, prev_mode != RPAS_MODE_DIRECT, out);
         f->loops_active = false;
     } else if (f->fallback == RPAS_FB_NAV_INVALID) {
@@ -457,6 +487,7 @@ void fcs_step(fcs_t *f, const fcs_inputs_t *in, const rpas_nav_msg_t *nav, int64
     cmd->ail = f->ail;
     cmd->rud = f->rud;
     cmd->thr = f->thr;
+    cmd->brake = (float)f->brake;
 
     memset(status, 0, sizeof *status);
     status->t_ns = now_ns;

@@ -62,6 +62,8 @@
     X(prot_pitch_min, -15.0, "pitch protection lower limit")                                  \
     X(prot_pitch_max, 20.0, "pitch protection upper limit")                                   \
     X(prot_vmin, 60.0, "under-speed protection threshold")                                    \
+    X(prot_vmin_land, 48.0, "under-speed protection threshold on a final approach and flare") \
+    X(ias_min_land, 55.0, "airspeed target lower limit on a final approach and flare")        \
     X(prot_vmax, 135.0, "over-speed protection threshold")                                    \
     X(prot_spd_pitch, 1.0, "pitch change per kt beyond a speed threshold")                    \
     X(prot_bank_kp, 0.03, "protection aileron per degree beyond the bank limit")              \
@@ -73,7 +75,12 @@
     X(mission_reengage_s, 1.0, "mission targets must be good this long to leave a fallback")  \
     X(direct_blend_s, 1.0, "fade from the last autopilot command to the stick on DIRECT")     \
     X(sensor_wait_s, 1.0, "after the start, attitude or air data never seen counts as lost")   \
-    X(sensor_reengage_s, 2.0, "attitude and air data good this long to leave SENSOR_LOST")
+    X(sensor_reengage_s, 2.0, "attitude and air data good this long to leave SENSOR_LOST")    \
+    /* roll-out after a landing */                                                             \
+    X(steer_k, 0.08, "rudder (nose-wheel steering) per degree of course error on the ground") \
+    X(rollout_elev, -0.1, "elevator on the ground (nose-up: keeps weight off the nose wheel)") \
+    X(brake_gs_kt, 70.0, "brakes only below this ground speed")                               \
+    X(brake_max, 0.8, "wheel brake command on the roll-out")
 
 typedef struct {
 #define FCS_PARAM_FIELD(name, def, doc) double name;
@@ -99,6 +106,7 @@ typedef struct {
 typedef struct {
     double hdg, alt, ias, vs;
     uint32_t lat_mode, vert_mode;
+    uint32_t flags; /* the mission's RPAS_MSN_* (landing phases, termination); 0 otherwise */
 } fcs_targets_t;
 
 typedef struct {
@@ -123,7 +131,7 @@ typedef struct {
     double hdg_i, roll_i, vs_i, pitch_i, thr_i;
     double direct_blend;     /* 0..1: share of the stick in DIRECT */
     double blend_from[4];    /* elev, ail, rud, thr when DIRECT was entered */
-    double elev, ail, rud, thr; /* last commands */
+    double elev, ail, rud, thr, brake; /* last commands */
     uint32_t env_flags;
 } fcs_t;
 

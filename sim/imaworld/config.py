@@ -52,6 +52,14 @@ class AdcParams:
 
 
 @dataclass(frozen=True)
+class RadaltParams:
+    period_ms: int = 50  # RADALT at 20 Hz
+    range_ft: float = 1500.0  # sent only below this height: a low-range radio altimeter
+    noise_ft: float = 0.3
+    gear_ft: float = 4.4  # the c172p's centre of gravity above the ground on its wheels
+
+
+@dataclass(frozen=True)
 class ActuatorParams:
     status_period_ms: int = 50  # ACT_STATUS at 20 Hz
     surface_rate: float = 2.0  # normalised units per second (full travel -1..1 in 1 s)
@@ -142,6 +150,7 @@ class WorldParams:
     gps: GpsParams = field(default_factory=GpsParams)
     ahrs: AhrsParams = field(default_factory=AhrsParams)
     adc: AdcParams = field(default_factory=AdcParams)
+    radalt: RadaltParams = field(default_factory=RadaltParams)
     actuators: ActuatorParams = field(default_factory=ActuatorParams)
     station: StationParams = field(default_factory=StationParams)
     atmosphere: AtmosphereParams = field(default_factory=AtmosphereParams)

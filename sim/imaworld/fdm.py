@@ -41,6 +41,8 @@ PROPS = {
     "nz": "accelerations/Nz",
     "wind_n": "atmosphere/total-wind-north-fps",
     "wind_e": "atmosphere/total-wind-east-fps",
+    "wow_l": "gear/unit[1]/WOW",  # weight on the main wheels
+    "wow_r": "gear/unit[2]/WOW",
 }
 CONTROLS = ("fcs/elevator-cmd-norm", "fcs/aileron-cmd-norm", "fcs/rudder-cmd-norm",
             "fcs/throttle-cmd-norm[0]")
@@ -81,6 +83,9 @@ class Aircraft:
         self.node = {k: pm.get_node(v, False) for k, v in PROPS.items()}
         self.get = {k: n.get_double_value for k, n in self.node.items()}
         self.ctl_set = tuple(pm.get_node(n, False).set_double_value for n in CONTROLS)
+        self._steer = pm.get_node("fcs/steer-cmd-norm", False).set_double_value
+        self._brakes = (pm.get_node("fcs/left-brake-cmd-norm", False).set_double_value,
+                        pm.get_node("fcs/right-brake-cmd-norm", False).set_double_value)
         self._wind_n = pm.get_node("atmosphere/wind-north-fps", False)
         self._wind_e = pm.get_node("atmosphere/wind-east-fps", False)
         self.run = fdm.run
@@ -155,6 +160,14 @@ class Aircraft:
         s[1](ail)
         s[2](-rud)
         s[3](thr)
+
+    def set_ground_controls(self, rud: float, brake: float) -> None:
+        """On the ground: the nose wheel steered with the rudder pedals (+ = right, as the
+        DBC's rudder; JSBSim's fcs/steer-cmd-norm turns right when positive), and both main
+        wheels braked."""
+        self._steer(rud)
+        self._brakes[0](brake)
+        self._brakes[1](brake)
 
 
 def quiet_stdout():

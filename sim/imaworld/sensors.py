@@ -11,7 +11,7 @@ import numpy as np
 
 from ima.canbus.codec import MESSAGES
 
-from .config import FT_TO_M, AdcParams, AhrsParams, GpsParams
+from .config import FT_TO_M, AdcParams, AhrsParams, GpsParams, RadaltParams
 
 R_EARTH_M = 6_378_137.0
 MPS_TO_KT = 1.0 / 0.514444
@@ -23,6 +23,7 @@ _AHRS_ATT = MESSAGES["AHRS_ATT"]
 _AHRS_RATE = MESSAGES["AHRS_RATE"]
 _AHRS_ACCEL = MESSAGES["AHRS_ACCEL"]
 _AIR_DATA = MESSAGES["AIR_DATA"]
+_RADALT = MESSAGES["RADALT"]
 
 
 def normal_stream(seed: int, name: str):
@@ -243,3 +244,22 @@ class AirData:
         alt = palt_ft + self.b_alt.step() + P.noise_alt_ft * n()
         vs = hdot_fps * 60.0 + P.noise_vs_fpm * n()
         return [(_AIR_DATA.frame_id, _AIR_DATA.encode(ias, alt, vs, 1, c))]
+
+
+class RadarAltimeter:
+    """Radar altimeter: RADALT, the height of the main wheels above the ground (the antenna
+    is calibrated to read 0 on the wheels), below its range only (nothing is sent above it)."""
+
+    def __init__(self, p: RadaltParams, seed: int) -> None:
+        self.p = p
+        self.n = normal_stream(seed, "radalt")
+        self.cnt = 0
+
+    def sample(self, agl_ft: float) -> list[tuple[int, bytes]]:
+        h = agl_ft - self.p.gear_ft
+        if not h < self.p.range_ft:
+            return []
+        self.cnt = c = (self.cnt + 1) & 0x7F
+        h = max(0.0, h + self.p.noise_ft * self.n())
+        return [(_RADALT.frame_id, _RADALT.encode(h, 1, c))]
+

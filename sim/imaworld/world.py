@@ -19,9 +19,10 @@ from .config import DEFAULT, NS, VotingParams, WorldParams
 from .faults import WorldFaults
 from .faultspec import FaultSpec
 from .fdm import Aircraft
+from .landing import Ground
 from .pilot import LAT_MODE_CODES, MODE_CODES, VERT_MODE_CODES, PilotScript
 from .pilot_model import PilotModel
-from .sensors import Ahrs, AirData, Gps, cas_from_impact, static_pressure
+from .sensors import Ahrs, AirData, Gps, RadarAltimeter, cas_from_impact, static_pressure
 from .traffic import Traffic
 from .uplink import Uplink
 
@@ -41,6 +42,9 @@ _NAV_POS = {MESSAGES[f"NAV_POS_{c}"].frame_id: (i, MESSAGES[f"NAV_POS_{c}"].deco
             for i, c in enumerate(CHANNELS)}
 _NAV_DATA = {MESSAGES[f"NAV_DATA_{c}"].frame_id: (i, MESSAGES[f"NAV_DATA_{c}"].decode)
              for i, c in enumerate(CHANNELS)}
+_BRAKE_CMD = {MESSAGES[f"BRAKE_CMD_{c}"].frame_id: (i, MESSAGES[f"BRAKE_CMD_{c}"].decode)
+              for i, c in enumerate(CHANNELS)}
+NEAR_GROUND_FT = 15.0  # below this height (of the centre of gravity) the wheels are watched
 FCS_MODES = choices("FCS_STATUS_A", "FCS_MODE_A")
 FCS_FALLBACKS = choices("FCS_STATUS_A", "FCS_FALLBACK_A")
 
@@ -114,6 +118,7 @@ class World:
         self.gps = Gps(params.gps, seed)
         self.ahrs = Ahrs(params.ahrs, seed)
         self.adc = AirData(params.adc, seed)
+        self.radalt = RadarAltimeter(params.radalt, seed)
         # station
         self.station = dict(script.initial)
         self.pil_cnt = 0
@@ -124,6 +129,8 @@ class World:
         self.uplink = Uplink(opts.uploads) if opts.uploads or script.has_mission else None
         self._uplink_ev_done = 0
         self.traffic = Traffic(script.traffic) if script.traffic else None
+        self.ground = Ground()
+        self._ground_ev_done = 0
         self._traffic_ev_done = 0
         self._pm_done = 0
         self._stick_scripted = False  # the script flies the stick itself (see _scripted)
@@ -237,6 +244,7 @@ class World:
             [0, p.gps.period_ms * ms, self._gps],
             [0, p.ahrs.period_ms * ms, self._ahrs],
             [0, p.adc.period_ms * ms, self._adc],
+            [0, p.radalt.period_ms * ms, self._radalt],
             [0, p.actuators.status_period_ms * ms, self._act_status],
             [0, p.station.mode_period_ms * ms, self._uplink_mode],
             [0, p.station.stick_period_ms * ms, self._uplink_stick],
@@ -299,6 +307,11 @@ class World:
         if pt is not None:  # blocked pitot: the trapped total pressure against the static
             cas = cas_from_impact(pt - static_pressure(g["palt"]()))
         self._send(t, self.adc.sample(cas, g["palt"](), g["hdot"]()))
+
+    def _radalt(self, t: int) -> None:
+        frames = self.radalt.sample(self.ac.get["agl"]())
+        if frames:
+            self._send(t, frames)
 
     def _act_status(self, t: int) -> None:
         pos = self.act.pos
@@ -398,6 +411,10 @@ class World:
                 e, ai, ru, th, _cnt = a[1](f.data)
                 self.act.command(a[0], f.t_ns, (e, ai, ru, th))
                 continue
+            b = _BRAKE_CMD.get(fid)
+            if b is not None:
+                self.ground.brake_command(b[0], f.t_ns, b[1](f.data)[0])
+                continue
             if not link_up:
                 continue
             s = _FCS_STATUS.get(fid)
@@ -429,6 +446,7 @@ class World:
         run, set_controls, dt, hz = ac.run, ac.set_controls, self.dt, self.hz
         lim = self.p.limits
         agl, phi, cas, nz = g["agl"], g["phi"], g["cas"], g["nz"]
+        ground = self.ground
         n = self.n
         while self.next_step_t <= t:
             t_n = n * NS // hz
@@ -448,7 +466,23 @@ class World:
             if not c <= lim.max_cas_kt or not abs(z) <= lim.max_load_g:
                 self._crash(f"airspeed {c:.1f} kt" if not c <= lim.max_cas_kt
                             else f"load factor {z:.1f} g")
+            if a < NEAR_GROUND_FT:
+                self._near_ground(ground, a, r, pos, dt)
         self._log_actuators()
+
+    def _near_ground(self, ground: Ground, agl_ft: float, roll_deg: float, pos, dt: float) -> None:
+        """The wheels near the ground: steering, brakes, touchdown, bounces, the stop."""
+        g = self.ac.get
+        self.ac.set_ground_controls(pos[2], ground.brake_step(self.t_now, dt))
+        vn, ve = g["vn"](), g["ve"]()
+        why = ground.step(self.t_now, g["wow_l"]() > 0.5 or g["wow_r"]() > 0.5, agl_ft,
+                          -g["hdot"](), roll_deg, g["theta"](),
+                          math.hypot(vn, ve) / 1.6878098571011957, g["lat"](), g["lon"]())
+        for t, kind, f in ground.events[self._ground_ev_done:]:
+            self.event("gear", kind, t_ns=t, **f)
+        self._ground_ev_done = len(ground.events)
+        if why is not None:
+            self._crash(why)
 
     def _log_actuators(self) -> None:
         """Actuator state changes and the voter's events, in time order (a vote before the
@@ -571,6 +605,8 @@ class World:
             summary["test_switches"] = list(self.opts.test_switches)
         if self.pilot_model.events:
             summary["pilot_model"] = [{"t_ns": t, **f} for t, f in self.pilot_model.events]
+        if self.ground.touchdown is not None:
+            summary["landing"] = self.ground.summary()
         (self.run_dir / "world.json").write_text(json.dumps(summary, indent=1) + "\n")
         emu = self.t_end / NS
         print(f"imaworld: {emu:.1f} s emulated, {self.n} steps, {wall_s:.2f} s wall"

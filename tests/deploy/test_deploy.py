@@ -130,7 +130,7 @@ def test_generate_result(triplex: DeployResult) -> None:
     assert io_ == {**io_, "personality": "apex-c", "rate_hz": 20.0, "processes": ["rx", "tx"],
                    "inputs": ["ACT_CMD_IN", "FCS_STATUS_IN", "NAV_IN", "MM_STATUS_IN"],
                    "outputs": ["GPS_OUT", "AHRS_OUT", "AIR_OUT", "PILOT_OUT", "ACT_OUT",
-                               "PLAN_OUT", "MM_CMD_OUT", "TRAFFIC_OUT"],
+                               "PLAN_OUT", "MM_CMD_OUT", "TRAFFIC_OUT", "RADALT_OUT"],
                    "criticality": "LEVEL_A", "replicated": False, "system_partition": True}
     assert s["partitions"][1]["replicated"] is True
     fdr = s["partitions"][2]
@@ -139,9 +139,9 @@ def test_generate_result(triplex: DeployResult) -> None:
     mm = s["partitions"][3]
     assert mm == {**mm, "criticality": "LEVEL_B", "replicated": False,
                   "inputs": ["NAV_IN", "FCS_STATUS_IN", "PILOT_IN", "MM_CMD_IN", "TRAFFIC_IN",
-                             "PLAN_IN"],
+                             "RADALT_IN", "PLAN_IN"],
                   "outputs": ["MISSION_OUT", "MM_STATUS_OUT"]}
-    assert s["channels"] == {"intra_node": 13, "can_messages": 28, "dds_topics": 4}
+    assert s["channels"] == {"intra_node": 14, "can_messages": 32, "dds_topics": 4}
     assert s["total_lines"] == sum(n for _, n in triplex.files)
 
 
@@ -152,7 +152,7 @@ def test_each_replica_sends_on_its_own_redundancy_channel(triplex: DeployResult)
         letter = {"node1": "A", "node2": "B", "node3": "C"}[p["node"]]
         assert p["can_sends"] == [f"ACT_CMD_{letter}", f"FCS_STATUS_{letter}",
                                   f"NAV_POS_{letter}", f"NAV_DATA_{letter}",
-                                  f"MISSION_STATUS_{letter}"]
+                                  f"MISSION_STATUS_{letter}", f"BRAKE_CMD_{letter}"]
         # Every node hears every node's heartbeat (membership).
         assert {"FCS_STATUS_A", "FCS_STATUS_B", "FCS_STATUS_C"} <= set(p["can_receives"])
 
@@ -190,7 +190,7 @@ def test_simplex_deploys_one_module(tmp_path: Path) -> None:
     assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*") if p.is_file()) \
         == ["glue/fdr_ports.h", "glue/io_ports.h", "glue/mission_manager_ports.h",
             "glue/nav_fcs_ports.h", "glue/rpas_system.h", "node1.xml"]
-    assert result.summary["channels"] == {"intra_node": 13, "can_messages": 18, "dds_topics": 4}
+    assert result.summary["channels"] == {"intra_node": 14, "can_messages": 20, "dds_topics": 4}
     assert "#define RPAS_NODE_COUNT      1" in (tmp_path / "glue" / "rpas_system.h").read_text()
 
 
@@ -435,7 +435,7 @@ def test_command_prints_the_summary(tmp_path: Path, capsys) -> None:
     assert [r[:4] for r in rows] == [[p, n, "apex-c", "20"] for n in ("node1", "node2", "node3")
                                      for p in ("io", "nav_fcs", "fdr", "mission_manager")]
     assert [r[-1] for r in rows] == ["no", "yes", "no", "no"] * 3
-    assert "Channels: 13 intra-node per node, 28 CAN messages, 4 DDS topics" in out
+    assert "Channels: 14 intra-node per node, 32 CAN messages, 4 DDS topics" in out
     assert "Generated 8 files, " in out
     for name in ("node1.xml", "node2.xml", "node3.xml", "glue/io_ports.h",
                  "glue/nav_fcs_ports.h", "glue/fdr_ports.h", "glue/mission_manager_ports.h",
@@ -452,7 +452,7 @@ def test_command_json(tmp_path: Path, capsys) -> None:
     assert out.count("\n") == 1
     summary = json.loads(out)
     assert summary["system"] == "rpas_triplex"
-    assert summary["channels"] == {"intra_node": 13, "can_messages": 28, "dds_topics": 4}
+    assert summary["channels"] == {"intra_node": 14, "can_messages": 32, "dds_topics": 4}
     assert [f["path"] for f in summary["files"]] == [
         "node1.xml", "node2.xml", "node3.xml", "glue/io_ports.h", "glue/nav_fcs_ports.h",
         "glue/fdr_ports.h", "glue/mission_manager_ports.h", "glue/rpas_system.h"]

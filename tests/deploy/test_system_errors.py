@@ -130,7 +130,7 @@ def test_a_queuing_port_needs_a_capacity(tmp_path, good) -> None:
     msg, _ = refuse(tmp_path, good,
                     lambda d: d["partitions"][0]["ports"].append(
                         {"name": "Q", "direction": "source", "kind": "queuing", "size": 8}))
-    assert msg.endswith(": partitions[0].ports[12]: 'max_messages' is a required property"), msg
+    assert msg.endswith(": partitions[0].ports[13]: 'max_messages' is a required property"), msg
 
 
 def test_several_errors_are_listed_with_their_lines(tmp_path, good) -> None:
@@ -255,7 +255,7 @@ SEMANTIC_CASES = [
      lambda d: d["partitions"][0]["ports"].append(
          {"name": "Q", "direction": "source", "kind": "queuing", "size": 8, "max_messages": 4,
           "refresh_s": 0.1}),
-     "partitions[0].ports[12].refresh_s: only a sampling port has a refresh period",
+     "partitions[0].ports[13].refresh_s: only a sampling port has a refresh period",
      "refresh_s: 0.1"),
     ("unknown channel port",
      lambda d: d["channels"]["intra_node"][0].update({"from": "io.GPS_OUTX"}),
@@ -309,11 +309,11 @@ SEMANTIC_CASES = [
      "NUMERIC_ERROR: PROCESS"),
     ("unknown CAN message",
      lambda d: d["channels"]["can"]["partitions"]["io"]["receives"].append("GPS_SPEED"),
-     "channels.can.partitions.io.receives[14]: 'GPS_SPEED' (node1) is not a message of rpas.dbc",
+     "channels.can.partitions.io.receives[15]: 'GPS_SPEED' (node1) is not a message of rpas.dbc",
      "GPS_SPEED"),
     ("sending on every channel",
      lambda d: d["channels"]["can"]["partitions"]["io"]["sends"].append("NAV_POS_{channels}"),
-     "channels.can.partitions.io.sends[5]: 'NAV_POS_{channels}': a node sends on its own "
+     "channels.can.partitions.io.sends[6]: 'NAV_POS_{channels}': a node sends on its own "
      "redundancy channel only: use {channel}", "NAV_POS_{channels}"),
     ("CAN traffic of an unknown partition",
      lambda d: d["channels"]["can"]["partitions"].update(mm={"sends": ["GPS_POS"]}),

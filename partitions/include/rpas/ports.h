@@ -84,7 +84,7 @@ typedef struct {
 typedef struct {
     int64_t t_ns;
     uint32_t seq;
-    uint32_t pad;
+    float brake; /* wheel brakes 0..1 (the roll-out after a landing; 0 in flight) */
     double elev, ail, rud, thr;
 } rpas_act_cmd_msg_t;
 
@@ -142,6 +142,14 @@ typedef struct {
     uint32_t cmd;      /* enum rpas_mm_cmd */
     uint32_t leg;      /* DIRECT_TO: the leg */
 } rpas_mm_cmd_msg_t;
+
+/* io -> mission manager: port RADALT_IN (the radar altimeter, below its range) */
+typedef struct {
+    int64_t t_ns;
+    uint32_t seq;
+    uint32_t valid;   /* 1: a height */
+    double height_ft; /* of the main wheels above the ground */
+} rpas_radalt_msg_t;
 
 /* io -> mission manager: port TRAFFIC_IN (the surveillance receiver's nearest intruder,
  * relative to the aircraft) */

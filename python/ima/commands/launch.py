@@ -75,7 +75,12 @@ def add_run_arguments(parser: argparse.ArgumentParser, kind: str = "launch") -> 
     parser.add_argument("--seed", type=int, default=1, metavar="N",
                         help="seed of sensor noise and turbulence (default 1)")
     parser.add_argument("--pilot", type=Path, metavar="FILE",
-                        help="remote pilot script (default sim/pilots/default.yaml)")
+                        help="remote pilot script (default sim/pilots/default.yaml; with "
+                        "--mission sim/pilots/fly_mission.yaml)")
+    parser.add_argument("--mission", type=Path, metavar="PLAN.yaml",
+                        help="a mission plan (config/missions/): the station uplinks it over "
+                        "the C2 link and the mission manager flies it; the summary gains each "
+                        "leg's accuracy (docs/mission.md)")
     parser.add_argument("--turbulence", choices=launch_options.TURBULENCE, default="light",
                         help="MIL-F-8785C turbulence (default light)")
     parser.add_argument("--wind", type=wind_kt, default=10.0, metavar="KT",
@@ -164,6 +169,7 @@ def options_from(args: argparse.Namespace, system: Path | None = None,
                  kind: str = "launch") -> launch_options.LaunchOptions:
     return launch_options.LaunchOptions(
         system=system or args.system, duration_s=args.duration, seed=args.seed, pilot=args.pilot,
+        mission=args.mission,
         turbulence=args.turbulence, wind_kt=args.wind, realtime=args.realtime,
         run_dir=args.run_dir, kind=kind, kill=list(args.kill_node), hang=list(args.hang_node),
         wrong_output=list(args.test_wrong_output), netns=args.netns, faults=faults_from(args),
@@ -184,7 +190,8 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
     console = Console(stderr=json_out)
     system = load_system(Path(opts.system))
     nodes = [n.name for n in system.nodes]
-    pilot = Path(opts.pilot) if opts.pilot else launch_options.default_pilot()
+    pilot = Path(opts.pilot) if opts.pilot else launch_options.default_pilot(
+        opts.mission is not None)
     progress = Progress(TextColumn("[bold]flight[/]"), BarColumn(),
                         TextColumn("{task.completed:>6.0f}/{task.total:.0f} s"),
                         TimeRemainingColumn(), console=console)
@@ -228,6 +235,21 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
     summary = launch_summary.summarise(result.run_dir, pilot, opts.duration_s, result.nodes,
                                        result.killed, result.wall_s, plot=True,
                                        hung=result.hung)
+    if opts.mission is not None:
+        from ima.mission import flown
+        from ima.mission import plan as mission_plan
+
+        gone = {**result.killed, **result.hung}
+        node = next((n for n in result.nodes if n not in gone), result.nodes[0])
+        summary.update(flown.judge(result.run_dir, mission_plan.load(opts.mission), node))
+        from ima.mission import track
+
+        try:  # a full disk: the summary says so, the run is not lost
+            path = track.write_track(result.run_dir, mission_plan.load(opts.mission), summary)
+            summary["track_png"] = str(path)
+        except OSError as exc:
+            summary["track_png"] = None
+            summary["track_error"] = f"{Path(result.run_dir) / 'track.png'}: {exc.strerror}"
     summary["returncodes"] = result.returncodes
     # Ctrl-C (or SIGTERM): the run ended early, at the last emulated time the world recorded
     summary["interrupted"] = bool(result.interrupted)

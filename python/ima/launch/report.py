@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Prints a run's summary (ima.launch.summary) on the terminal: the flight judged from the
-truth, then, with several nodes, what the redundancy did."""
+truth, the mission flown leg by leg (with --mission), then, with several nodes, what the
+redundancy did."""
 
 from __future__ import annotations
 
@@ -42,6 +43,82 @@ def print_flight(s: dict, console) -> None:
                       f"{ev.get('error')} → {ev.get('action')}", markup=False)
 
 
+def _pair(a, b, d: int = 1, sep: str = " / ") -> str:
+    """"a / b" with d decimals; "-" when neither is known."""
+    if a is None and b is None:
+        return "-"
+    return sep.join("-" if v is None else f"{v:.{d}f}" for v in (a, b))
+
+
+def _at(t_s) -> str:
+    return "-" if t_s is None else f"{t_s:.1f} s"
+
+
+def _legs_flown(m: dict, legs: list[dict]) -> str:
+    """"4/4 legs flown (and 2 of procedures)": the mission's legs (its IF is not flown) and the
+    contingency procedures' legs, as the judge counted them."""
+    planned, flown, extra = (m.get(k) for k in ("legs_planned", "legs_flown",
+                                                  "procedure_legs_flown"))
+    if not all(isinstance(x, int) for x in (planned, flown, extra)):
+        return f"{len(legs)} legs flown"
+    return f"{flown}/{planned} legs flown" + (f" (and {extra} of procedures)" if extra else "")
+
+
+def print_mission(s: dict, console) -> None:
+    """The mission flown (ima.mission.flown.judge): each leg's accuracy, the contingencies,
+    the track's PNG."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    m = s.get("mission") or {}
+    legs = s.get("legs") or []
+    final = m.get("final_state") or "no state reported"
+    at = f" at leg {m['final_leg']}" if m.get("final_leg") not in (None, -1) else ""
+    console.print(f"Mission {escape(str(m.get('plan', '?')))} (plan {m.get('plan_id', '?')}, "
+                  f"{m.get('node', '?')}'s mission manager): {final}{at}; "
+                  f"{_legs_flown(m, legs)}")
+    if legs:
+        console.print("Legs, judged on the truth from their capture (xte: cross-track error):")
+        # the label is "INDEX TYPE" unless the judge names legs otherwise: then it has a column
+        labelled = any(g.get("label") != f"{g.get('index')} {g.get('type')}" for g in legs)
+        t = Table(show_edge=False)
+        for col in ("leg", "type") + (("label",) if labelled else ()) + (
+                "time", "xte p95 / max", "alt err p95 / max", "airspeed", "captured"):
+            t.add_column(col, justify="left" if col in ("type", "label") else "right")
+        for g in legs:
+            captured = "yes" if g.get("captured") else "[red]no[/]"
+            row = [str(g.get("index")), escape(str(g.get("type")))]
+            if labelled:
+                row.append(escape(str(g.get("label"))))
+            row += [_pair(g.get("t_start_s"), g.get("t_end_s"), sep="–") + " s",
+                    _pair(g.get("xte_m_p95"), g.get("xte_m_max")) + " m",
+                    _pair(g.get("alt_err_m_p95"), g.get("alt_err_m_max")) + " m",
+                    _pair(g.get("ias_kt_min"), g.get("ias_kt_max"), sep="–") + " kt", captured]
+            t.add_row(*row)
+        console.print(t)
+    else:
+        console.print("No leg of the plan flown")
+    conts = s.get("contingencies") or []
+    if conts:
+        console.print("Contingencies:")
+        t = Table(show_edge=False)
+        for col in ("event", "declared", "procedure", "resumed", "resumed at leg"):
+            t.add_column(col, justify="left" if col == "event" else "right")
+        for c in conts:
+            declared = _at(c.get("t_s")) + (f" (leg {c['leg']})" if c.get("leg") is not None
+                                            else "")
+            t.add_row(escape(str(c.get("event"))), declared, _at(c.get("procedure_t_s")),
+                      _at(c.get("resumed_t_s")),
+                      "-" if c.get("resumed_leg") is None else str(c["resumed_leg"]))
+        console.print(t)
+    else:
+        console.print("Contingencies: none declared")
+    if s.get("track_png"):
+        console.print(f"track: {s['track_png']}", markup=False)
+    elif s.get("track_error"):
+        console.print(f"track: not written: {s['track_error']}", markup=False)
+
+
 def print_redundancy(s: dict, console) -> None:
     killed = ", ".join([f"{k['node']}@{k['t_s']:g}s (killed)" for k in s["killed"]]
                        + [f"{k['node']}@{k['t_s']:g}s (hung)" for k in s.get("hung", [])]) or "none"
@@ -75,6 +152,8 @@ def print_summary(s: dict, console) -> None:
                       (f" at {at:g} s of emulated time" if at is not None else "") +
                       ": what follows is the run up to there")
     print_flight(s, console)
+    if "legs" in s:
+        print_mission(s, console)
     if len(s.get("nodes", [])) > 1:
         print_redundancy(s, console)
     else:

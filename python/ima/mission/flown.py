@@ -13,6 +13,7 @@ has levelled off at the constraint."""
 from __future__ import annotations
 
 import json
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,6 +24,7 @@ from ima.mission.geometry import FT, LegPath, leg_paths
 from ima.mission.plan import Plan
 
 CAPTURE_M = 50.0
+AUTOLAND_JUDGED_ABOVE_FT = 50.0
 CAPTURE_ALT_M = 15.0
 _STATE = re.compile(r"mission_manager: ([A-Z_]+) leg (-?\d+) (\S+)$")
 _DECLARED = re.compile(r"mission_manager: contingency (\w+) declared at leg (-?\d+)$")
@@ -41,15 +43,26 @@ class Interval:
 
 def reports(trace: Path) -> list[tuple[int, str]]:
     """The mission manager's reports in a node's trace: [(t_ns, text)]."""
-    out = []
-    with open(trace, encoding="utf-8") as f:
+    out: list[tuple[int, str]] = []
+    if not Path(trace).is_file():
+        return out
+    with open(trace, encoding="utf-8", errors="replace") as f:
         for line in f:
             if '"mission_manager"' not in line or '"app_message"' not in line:
                 continue
-            rec = json.loads(line)
-            if rec.get("kind") == "app_message" and rec.get("src") == "mission_manager":
-                out.append((rec["t_ns"], rec.get("text", "")))
+            rec = _record(line)
+            if rec and rec.get("kind") == "app_message" and rec.get("src") == "mission_manager":
+                out.append((int(rec.get("t_ns", 0)), str(rec.get("text", ""))))
     return out
+
+
+def _record(line: str) -> dict | None:
+    """A JSON line, or None for a line cut short (a run killed while it wrote)."""
+    try:
+        rec = json.loads(line)
+    except ValueError:
+        return None
+    return rec if isinstance(rec, dict) else None
 
 
 def intervals(msgs: list[tuple[int, str]], end_ns: int) -> list[Interval]:
@@ -84,10 +97,13 @@ def contingencies(msgs: list[tuple[int, str]]) -> list[dict]:
 def load_truth(path: Path) -> dict[str, np.ndarray]:
     cols = ("t_ns", "lat_deg", "lon_deg", "alt_ft", "agl_ft", "airspeed_kt", "gs_kt")
     rows = []
-    with open(path, encoding="utf-8") as f:
-        for line in f:
-            r = json.loads(line)
-            rows.append([r.get(c) if r.get(c) is not None else np.nan for c in cols])
+    if Path(path).is_file():
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for line in f:
+                r = _record(line)
+                if r is not None and isinstance(r.get("t_ns"), int):
+                    rows.append([r.get(c) if isinstance(r.get(c), (int, float)) else np.nan
+                                 for c in cols])
     a = np.array(rows, dtype=float).reshape(-1, len(cols))
     return {c: a[:, i] for i, c in enumerate(cols)}
 
@@ -144,6 +160,59 @@ def leg_stats(path: LegPath, geometric: bool, ne: np.ndarray, alt_ft: np.ndarray
     }
 
 
+def world_events(run_dir: Path, kinds: set[str]) -> list[dict]:
+    out = []
+    path = Path(run_dir) / "world.jsonl"
+    if not path.is_file():
+        return out
+    with open(path, encoding="utf-8", errors="replace") as f:
+        for line in f:
+            rec = _record(line)
+            if rec is not None and rec.get("kind") in kinds:
+                out.append(rec)
+    return out
+
+
+def autoland(run_dir: Path, plan: Plan, frame) -> dict | None:
+    """The landing on the plan's AUTOLAND runway, from the world's gear events: where the
+    main wheels touched against the aim point (+ beyond it) and the centre line, the sink
+    rate, bounces, and where (whether) the aircraft stopped on the runway. None: the plan has
+    no landing."""
+    leg = next((lg for lg in plan.legs if lg.type == "AUTOLAND"), None)
+    if leg is None:
+        return None
+    rw = plan.runways[leg.runway]
+    thr = frame.to_local(rw.lat_deg, rw.lon_deg)
+    u = np.array([math.cos(math.radians(rw.heading_deg)), math.sin(math.radians(rw.heading_deg))])
+    right = np.array([-u[1], u[0]])
+
+    def where(ev: dict) -> tuple[float, float]:
+        d = frame.to_local(ev["lat_deg"], ev["lon_deg"]) - thr
+        return float(d @ u), float(d @ right)
+
+    ev = world_events(run_dir, {"touchdown", "bounce", "stopped", "crash"})
+    td = next((e for e in ev if e["kind"] == "touchdown"), None)
+    stop = next((e for e in ev if e["kind"] == "stopped"), None)
+    crash = next((e for e in ev if e["kind"] == "crash"), None)
+    out = {"runway": rw.name, "landed": td is not None, "crashed": crash is not None,
+           "crash_reason": crash.get("reason") if crash else None,
+           "touchdown_t_s": None, "touchdown_from_aim_m": None, "centerline_m": None,
+           "sink_fps": None, "bounced": any(e["kind"] == "bounce" for e in ev),
+           "stopped": stop is not None, "stop_from_threshold_m": None,
+           "stopped_on_runway": False}
+    if td is not None:
+        along, across = where(td)
+        out.update(touchdown_t_s=round(td["t_ns"] / 1e9, 2),
+                   touchdown_from_aim_m=round(along - rw.aim_point_m, 1),
+                   centerline_m=round(abs(across), 2), sink_fps=td["sink_fps"])
+    if stop is not None:
+        along, across = where(stop)
+        out["stop_from_threshold_m"] = round(along, 1)
+        out["stopped_on_runway"] = bool(0.0 <= along <= rw.length_m and
+                                        abs(across) <= rw.width_m / 2)
+    return out
+
+
 def judge(run_dir: Path, plan: Plan, node: str) -> dict:
     """The summary's `mission`, `legs` and `contingencies` of a run flown with `plan`, from
     `node`'s mission manager (every replica flies the same)."""
@@ -159,8 +228,10 @@ def judge(run_dir: Path, plan: Plan, node: str) -> dict:
     frame = Frame(plan.origin_lat_deg, plan.origin_lon_deg)
     ne_all = frame.to_local(truth["lat_deg"], truth["lon_deg"]) if len(t) else np.zeros((0, 2))
     legs = []
+    n_mission = len(plan.legs)
     by_index = {p.index: p for p in paths}
-    geometric = {i: leg.geometric for i, (leg, _) in enumerate(plan.image_legs())}
+    geometric = {i: leg.geometric or leg.type == "AUTOLAND"
+                 for i, (leg, _) in enumerate(plan.image_legs())}
     flown: dict[int, np.ndarray] = {}
     for iv in ivs:
         if iv.state not in ("ACTIVE", "CONTINGENCY") or iv.leg not in by_index:
@@ -171,15 +242,19 @@ def judge(run_dir: Path, plan: Plan, node: str) -> dict:
         flown[iv.leg] = mask if iv.leg not in flown else flown[iv.leg] | mask
     for idx in sorted(flown):
         m = flown[idx]
+        if by_index[idx].type == "AUTOLAND":  # the touchdown criteria judge below 50 ft
+            m = m & (truth["agl_ft"] >= AUTOLAND_JUDGED_ABOVE_FT)
         legs.append(leg_stats(by_index[idx], geometric[idx], ne_all[m], truth["alt_ft"][m],
                               truth["airspeed_kt"][m], t[m]))
     final = ivs[-1] if ivs else None
     return {
         "mission": {"plan": plan.name, "plan_id": plan.plan_id, "node": node,
-                    "legs_planned": sum(1 for p in paths if p.procedure is None),
-                    "legs_flown": len(legs),
+                    "legs_planned": sum(1 for leg in plan.legs if leg.type != "IF"),
+                    "legs_flown": sum(1 for lg in legs if lg["index"] < n_mission),
+                    "procedure_legs_flown": sum(1 for lg in legs if lg["index"] >= n_mission),
                     "final_state": final.state if final else None,
                     "final_leg": final.leg if final else None},
         "legs": legs,
         "contingencies": contingencies(msgs),
+        "autoland": autoland(run_dir, plan, frame),
     }

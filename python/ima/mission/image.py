@@ -118,13 +118,13 @@ def encode(plan: Plan) -> bytes:
     for name in CONTINGENCIES:
         c = plan.contingencies.get(name)
         if c is None:
-            records.append(CONTINGENCY.pack(ACTION_CODES["NONE"], 0, 0, 0, 0, NAN, NAN, NAN, NAN))
+            records.append(CONTINGENCY.pack(ACTION_CODES["NONE"], 0, 0, 0, 0, 0.0, 0.0, NAN, NAN))
             continue
         n = len(c.procedure)
         p1, p2 = (c.offset_deg, c.altitude_offset_ft) if c.action == "avoid" else (NAN, NAN)
         records.append(CONTINGENCY.pack(ACTION_CODES[c.action.upper()], int(c.resume),
                                         first if n else 0, n, 0, c.detect_s,
-                                        _num(c.continue_s), p1, p2))
+                                        c.continue_s or 0.0, p1, p2))
         first += n
     lim = plan.limits
     header = HEADER.pack(PLAN_MAGIC, PLAN_VERSION, len(legs), len(plan.legs), 0, plan.plan_id,

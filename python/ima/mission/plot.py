@@ -40,9 +40,20 @@ def map_height_in(span_n_m: float, span_e_m: float) -> float:
     return min(max(9.0 * (span_n_m + 1000.0) / (span_e_m + 1000.0), 4.0), 11.0)
 
 
-def draw_plan(ax, plan: Plan, paths: list[LegPath], alpha: float = 1.0) -> None:
+def _halfway(points: np.ndarray) -> np.ndarray:
+    """The point halfway along a polyline."""
+    if len(points) < 2:
+        return points[0]
+    run = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+    half = run[-1] / 2.0
+    return np.array([np.interp(half, run, points[:, 0]), np.interp(half, run, points[:, 1])])
+
+
+def draw_plan(ax, plan: Plan, paths: list[LegPath], alpha: float = 1.0,
+              width: float = 1.5) -> None:
     """The planned path on a map (east and north in km): every leg labelled with its index and
-    type, entries dotted, procedures dashed in their own colour; waypoints and runways."""
+    type halfway along it, entries dotted, procedures dashed in their own colour; waypoints and
+    runways. `alpha` and `width` (points) for the legs' lines."""
     frame = Frame(plan.origin_lat_deg, plan.origin_lon_deg)
     for p in paths:
         colour = _PROCEDURE_COLOUR if p.procedure else _KIND_COLOURS[p.kind]
@@ -52,9 +63,9 @@ def draw_plan(ax, plan: Plan, paths: list[LegPath], alpha: float = 1.0) -> None:
                     alpha=alpha)
         if len(p.points) == 0:
             continue
-        ax.plot(p.points[:, 1] / 1e3, p.points[:, 0] / 1e3, style, color=colour, lw=1.5,
+        ax.plot(p.points[:, 1] / 1e3, p.points[:, 0] / 1e3, style, color=colour, lw=width,
                 alpha=alpha)
-        mid = p.points[len(p.points) // 2]
+        mid = _halfway(p.points)
         name = p.label + (f" ({p.procedure})" if p.procedure else "")
         ax.annotate(name, (mid[1] / 1e3, mid[0] / 1e3), textcoords="offset points",
                     xytext=(4, 4), fontsize=8, color=colour)

@@ -67,13 +67,13 @@ RPAS_GLUE_CHECK(sizeof(rpas_nav_msg_t) == FDR_PORT_NAV_IN_SIZE,
 RPAS_GLUE_CHECK(sizeof(rpas_fcs_status_msg_t) == FDR_PORT_FCS_STATUS_IN_SIZE,
     "fdr.FCS_STATUS_IN: sizeof(rpas_fcs_status_msg_t) differs from the port size in the model (72)");
 
-/* MISSION_IN: sampling destination, channel 12 'mission_targets' from mission_manager.MISSION_OUT */
+/* MISSION_IN: sampling destination, channel 13 'mission_targets' from mission_manager.MISSION_OUT */
 #define FDR_PORT_MISSION_IN_NAME         "MISSION_IN"
 #define FDR_PORT_MISSION_IN_KIND         RPAS_PORT_SAMPLING
 #define FDR_PORT_MISSION_IN_DIRECTION    DESTINATION /* PORT_DIRECTION_TYPE */
 #define FDR_PORT_MISSION_IN_SIZE         56 /* MaxMessageSize, bytes */
 #define FDR_PORT_MISSION_IN_REFRESH_NS   500000000LL
-#define FDR_PORT_MISSION_IN_CHANNEL_ID   12
+#define FDR_PORT_MISSION_IN_CHANNEL_ID   13
 #define FDR_PORT_MISSION_IN_CHANNEL_NAME "mission_targets"
 #define FDR_PORT_MISSION_IN_MESSAGE      rpas_mission_msg_t /* its messages' C type */
 RPAS_GLUE_CHECK(sizeof(rpas_mission_msg_t) == FDR_PORT_MISSION_IN_SIZE,
@@ -97,7 +97,7 @@ static const rpas_process_spec_t fdr_process_spec[FDR_PROCESS_COUNT] = {
 static const rpas_port_spec_t fdr_port_spec[FDR_PORT_COUNT] = {
     [FDR_PORT_NAV_IN] = {"NAV_IN", RPAS_PORT_SAMPLING, DESTINATION, 112, 200000000LL, 0, 8},
     [FDR_PORT_FCS_STATUS_IN] = {"FCS_STATUS_IN", RPAS_PORT_SAMPLING, DESTINATION, 72, 200000000LL, 0, 7},
-    [FDR_PORT_MISSION_IN] = {"MISSION_IN", RPAS_PORT_SAMPLING, DESTINATION, 56, 500000000LL, 0, 12},
+    [FDR_PORT_MISSION_IN] = {"MISSION_IN", RPAS_PORT_SAMPLING, DESTINATION, 56, 500000000LL, 0, 13},
     [FDR_PORT_HM_LOG_IN] = {"HM_LOG_IN", RPAS_PORT_QUEUING, DESTINATION, 232, 0LL, 64, 0},
 };
 

@@ -108,13 +108,13 @@ RPAS_GLUE_CHECK(sizeof(rpas_pilot_msg_t) == NAV_FCS_PORT_PILOT_IN_SIZE,
 RPAS_GLUE_CHECK(sizeof(rpas_act_status_msg_t) == NAV_FCS_PORT_ACT_IN_SIZE,
     "nav_fcs.ACT_IN: sizeof(rpas_act_status_msg_t) differs from the port size in the model (48)");
 
-/* MISSION_IN: sampling destination, channel 12 'mission_targets' from mission_manager.MISSION_OUT */
+/* MISSION_IN: sampling destination, channel 13 'mission_targets' from mission_manager.MISSION_OUT */
 #define NAV_FCS_PORT_MISSION_IN_NAME         "MISSION_IN"
 #define NAV_FCS_PORT_MISSION_IN_KIND         RPAS_PORT_SAMPLING
 #define NAV_FCS_PORT_MISSION_IN_DIRECTION    DESTINATION /* PORT_DIRECTION_TYPE */
 #define NAV_FCS_PORT_MISSION_IN_SIZE         56 /* MaxMessageSize, bytes */
 #define NAV_FCS_PORT_MISSION_IN_REFRESH_NS   500000000LL
-#define NAV_FCS_PORT_MISSION_IN_CHANNEL_ID   12
+#define NAV_FCS_PORT_MISSION_IN_CHANNEL_ID   13
 #define NAV_FCS_PORT_MISSION_IN_CHANNEL_NAME "mission_targets"
 #define NAV_FCS_PORT_MISSION_IN_MESSAGE      rpas_mission_msg_t /* its messages' C type */
 RPAS_GLUE_CHECK(sizeof(rpas_mission_msg_t) == NAV_FCS_PORT_MISSION_IN_SIZE,
@@ -168,7 +168,7 @@ static const rpas_port_spec_t nav_fcs_port_spec[NAV_FCS_PORT_COUNT] = {
     [NAV_FCS_PORT_AIR_IN] = {"AIR_IN", RPAS_PORT_SAMPLING, DESTINATION, 40, 200000000LL, 0, 3},
     [NAV_FCS_PORT_PILOT_IN] = {"PILOT_IN", RPAS_PORT_SAMPLING, DESTINATION, 96, 1000000000LL, 0, 4},
     [NAV_FCS_PORT_ACT_IN] = {"ACT_IN", RPAS_PORT_SAMPLING, DESTINATION, 48, 200000000LL, 0, 5},
-    [NAV_FCS_PORT_MISSION_IN] = {"MISSION_IN", RPAS_PORT_SAMPLING, DESTINATION, 56, 500000000LL, 0, 12},
+    [NAV_FCS_PORT_MISSION_IN] = {"MISSION_IN", RPAS_PORT_SAMPLING, DESTINATION, 56, 500000000LL, 0, 13},
     [NAV_FCS_PORT_ACT_CMD_OUT] = {"ACT_CMD_OUT", RPAS_PORT_SAMPLING, SOURCE, 48, 200000000LL, 0, 6},
     [NAV_FCS_PORT_FCS_STATUS_OUT] = {"FCS_STATUS_OUT", RPAS_PORT_SAMPLING, SOURCE, 72, 200000000LL, 0, 7},
     [NAV_FCS_PORT_NAV_OUT] = {"NAV_OUT", RPAS_PORT_SAMPLING, SOURCE, 112, 200000000LL, 0, 8},

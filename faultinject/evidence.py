@@ -14,7 +14,8 @@ from faultinject.traces import parse_lines, t_ns_of
 
 SENSOR_IDS = {"gps": (0x9100190, 0x9100194), "ahrs": (0x9100320, 0x9100324, 0x9100328),
               "air": (0x91004B0,)}
-PILOT_IDS = (0x8B807D0, 0x8B807D4, 0x8B807D8)  # the C2 uplink: PILOT_MODE, _TARGETS, _STICK
+# the C2 uplink: PILOT_MODE, _TARGETS, _STICK, MISSION_UPLOAD, MISSION_CMD
+PILOT_IDS = (0x8B807D0, 0x8B807D4, 0x8B807D8, 0x8B807F8, 0x8B807FC)
 ACT_CMD_A = 0x8D80640
 
 

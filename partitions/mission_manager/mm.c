@@ -57,7 +57,6 @@ static bool end_point(const mm_leg_t *L, mm_vec_t *p)
     case RPAS_LEG_CA:
     case RPAS_LEG_FA:
     case RPAS_LEG_VA:
-    case RPAS_LEG_ORBIT:
     case RPAS_LEG_AUTOLAND:
         return false;
     case RPAS_LEG_SCAN: {
@@ -88,6 +87,8 @@ static double leaving_course(const mm_leg_t *next, mm_vec_t at)
         return r->course_deg;
     case RPAS_LEG_RF:
         return nf_wrap360(mm_course(next->p2, at) + 90.0 * ((r->flags & RPAS_LEG_TURN_LEFT) ? -1 : 1));
+    case RPAS_LEG_AUTOLAND: /* onto the final approach course */
+        return r->course_deg;
     default:
         return NAN;
     }
@@ -335,7 +336,8 @@ static uint32_t conditions(const mm_t *mm, const mm_inputs_t *in, const mm_state
 {
     const rpas_plan_header_t *h = &mm->plan.hdr;
     uint32_t c = 0;
-    if (!(in->pilot_ok && age_s(now, in->pilot.t_ns) <= mm->prm.c2_max_age_s))
+    /* the link: the pilot's last message, valid or not (the port keeps the last one) */
+    if (age_s(now, in->pilot.t_ns) > mm->prm.c2_max_age_s)
         c |= 1u << RPAS_CT_C2_LOSS;
     if (in->nav_ok && !(in->nav.flags & RPAS_NAV_GPS))
         c |= 1u << RPAS_CT_GPS_LOSS;
@@ -354,7 +356,7 @@ static uint32_t conditions(const mm_t *mm, const mm_inputs_t *in, const mm_state
 }
 
 /* Declares the contingencies whose condition held for their detection time. */
-static void detect(mm_t *mm, uint32_t cond, int64_t now)
+static void detect(mm_t *mm, uint32_t cond, int64_t now, int64_t in_pilot_t)
 {
     const rpas_plan_header_t *h = &mm->plan.hdr;
     uint32_t declared = 0;
@@ -364,7 +366,8 @@ static void detect(mm_t *mm, uint32_t cond, int64_t now)
             continue;
         }
         if (mm->cond_since[c] < 0)
-            mm->cond_since[c] = now;
+            /* C2 loss: since the link was last heard (the pilot's frames come at 20 Hz) */
+            mm->cond_since[c] = c == RPAS_CT_C2_LOSS && in_pilot_t > 0 ? in_pilot_t : now;
         if (age_s(now, mm->cond_since[c]) + 1e-9 >= h->contingency[c].detect_s)
             declared |= 1u << c;
     }
@@ -551,7 +554,7 @@ bool mm_step(mm_t *mm, const mm_inputs_t *in, int64_t now_ns, rpas_mission_msg_t
                 mm->state = RPAS_MM_ACTIVE;
         }
         if (mm->state != RPAS_MM_TERMINATED) {
-            detect(mm, conditions(mm, in, &st, now_ns), now_ns);
+            detect(mm, conditions(mm, in, &st, now_ns), now_ns, in->pilot.t_ns);
             uint32_t best = NONE_CT;
             for (uint32_t c = 0; c < RPAS_CT_COUNT; c++)
                 if ((mm->ct_flags & (1u << c)) && mm->plan.hdr.contingency[c].action != RPAS_CTA_NONE &&
@@ -573,6 +576,8 @@ bool mm_step(mm_t *mm, const mm_inputs_t *in, int64_t now_ns, rpas_mission_msg_t
                               .ias_kt = mm->plan.hdr.min_ias_kt};
         } else {
             mm_leg_step(&mm->ls, leg_of(mm), &mm->plan.hdr, &mm->prm, &st, &d);
+            if (mm->ls.note && !mm->event[0])
+                EVENT("leg %d %s", mm->ls.leg, mm->ls.note);
             bool sequencing = mm->state == RPAS_MM_ACTIVE || mm->state == RPAS_MM_CONTINGENCY;
             if (mm->ls.done && sequencing)
                 next_leg(mm, &st);
@@ -587,7 +592,8 @@ bool mm_step(mm_t *mm, const mm_inputs_t *in, int64_t now_ns, rpas_mission_msg_t
             static const uint32_t f[] = {RPAS_MSN_APPROACH, RPAS_MSN_FLARE, RPAS_MSN_ROLLOUT,
                                          RPAS_MSN_ROLLOUT};
             target->flags = f[mm->ls.phase & 3];
-            target->ias_kt = d.ias_kt; /* the approach's own speeds, under the cruise envelope */
+            if (isfinite(d.ias_kt)) /* the approach's own speeds, under the cruise envelope */
+                target->ias_kt = d.ias_kt;
         }
         if (mm->state == RPAS_MM_TERMINATED)
             target->flags = RPAS_MSN_TERMINATE;

@@ -26,17 +26,20 @@
     X(alt_band_ft, 50.0, "altitude reached: within this")                                     \
     X(energy_kb, 40.0, "vertical speed given up per kt of airspeed deficit (ft/min per kt)")  \
     X(energy_dead_kt, 3.0, "airspeed error the energy balance lets pass")                     \
-    X(c2_max_age_s, 1.5, "a pilot message older than this: the C2 link is lost")             \
+    X(c2_max_age_s, 0.25, "the pilot's last frame older than this: the C2 link is lost")    \
     X(cmd_max_age_s, 1.0, "io's plan-agreement message older than this is not used")         \
     X(traffic_max_age_s, 2.0, "a traffic report older than this is not used")                 \
     X(hold_default_leg_s, 60.0, "leg time of a hold made up in flight (pause, HOLD action)")  \
     X(hold_rate_dps, 3.0, "turn rate of holds (standard rate), unless max_bank_deg is less")  \
     X(gear_ft, 4.4, "height of the altitude reference above the main wheels on the ground")   \
     X(radalt_max_age_s, 0.3, "a radar altitude older than this is not used")                  \
-    X(flare_ft, 25.0, "wheel height at which the flare begins")                              \
-    X(flare_tau_s, 4.0, "the flare's time constant: the sink rate falls with the height")    \
-    X(flare_sink_fps, 1.5, "the sink rate the flare aims for at the ground")                 \
-    X(runway_xte_k, 1.0, "flare and roll-out: course correction per metre off the centre line")
+    X(approach_ias_kt, 70.0, "final approach airspeed of an AUTOLAND that gives none")        \
+    X(flare_ias_kt, 55.0, "airspeed target in the flare (the throttle is at idle)")          \
+    X(flare_ft, 15.0, "wheel height at which the flare begins")                              \
+    X(flare_tau_min_s, 2.0, "the flare's time constant, at least (taken from the sink then)") \
+    X(flare_sink_fps, 2.0, "the sink rate the flare aims for at the ground")                 \
+    X(flare_xte_k, 0.5, "flare: course correction per metre off the centre line")            \
+    X(runway_xte_k, 1.0, "roll-out: course correction per metre off the centre line")
 
 typedef struct {
 #define MM_PARAM_FIELD(name, value, meaning) double name;
@@ -138,7 +141,9 @@ typedef struct {
     int laps;
     int pass;
     int entry;       /* holds: enum mm_hold_entry */
+    bool racetrack;  /* holds: the entry is flown */
     double arc_rem0; /* Dubins: the first arc's angle when it began */
+    double flare_tau; /* AUTOLAND: the flare's time constant, from the sink rate it began with */
     /* fly-by: the course of the leg before, when it ended early to turn onto this one (NaN:
      * not so); the turn is flown as an arc tangent to both, then the leg's own segment */
     double flyby_crs;
@@ -148,6 +153,7 @@ typedef struct {
     int64_t phase_t0_ns;
     mm_dubins_t dubins;
     bool done;
+    const char *note; /* set for one cycle when the leg reaches a milestone (for the report) */
 } mm_leg_state_t;
 
 /* One leg with its positions in the local frame. */
@@ -189,6 +195,8 @@ typedef struct {
     double ias_kt;
     double xte_m, to_go_m;
     bool raw_vs;        /* the vertical speed as demanded (the flare): no energy balance */
+    double centre_k;    /* > 0: the course corrects this many deg per metre off the line
+                           (the flare, the runway), within 10 deg; 0: the vector field */
 } mm_demand_t;
 
 /* Starts leg L (from the present state; alt_ref_ft: the altitude flown so far). */

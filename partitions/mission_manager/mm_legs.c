@@ -271,6 +271,15 @@ static void hold_step(mm_leg_state_t *ls, const mm_leg_t *L, const mm_params_t *
             phase(ls, H_INBOUND, mm_line(ls->rt_i0, L->fix), st);
         break;
     }
+    /* the entry is flown once the racetrack's own phases begin */
+    bool on_racetrack = ls->phase >= H_TURN1 && ls->phase <= H_INBOUND;
+    if (on_racetrack && !ls->racetrack) {
+        static const char *const names[] = {"hold: direct entry flown, on the racetrack",
+                                            "hold: parallel entry flown, on the racetrack",
+                                            "hold: teardrop entry flown, on the racetrack"};
+        ls->racetrack = true;
+        ls->note = names[ls->entry];
+    }
 }
 
 static void dubins_step(mm_leg_state_t *ls, const mm_leg_t *L, const mm_state_t *st,
@@ -322,20 +331,28 @@ static void land_step(mm_leg_state_t *ls, const mm_leg_t *L, const mm_params_t *
     double gp = (r->a > 0.0f ? r->a : 3.0) * NF_DEG;
     double to_aim = 20000.0 - tk->along_m + r->b; /* along the centre line to the aim point */
     double path = elev + prm->gear_ft + to_aim * tan(gp) * FT_PER_M;
-    d->ias_kt = isfinite(r->ias_kt) ? r->ias_kt : 65.0;
     d->raw_vs = ls->phase != L_FINAL;
+    d->centre_k = ls->phase == L_FLARE ? prm->flare_xte_k
+                  : ls->phase != L_FINAL ? prm->runway_xte_k
+                                         : 0.0;
     switch (ls->phase) {
     case L_FINAL:
         /* below the glide path: level at the leg's start altitude until it is intercepted */
         d->alt_ft = fmin(path, fmax(ls->start_alt_ft, elev + 200.0));
         d->vs_ff_fpm = path <= ls->start_alt_ft ? -st->gs_mps * tan(gp) * FT_PER_M * 60.0 : 0.0;
-        if (wheels < prm->flare_ft && to_aim < 1500.0)
+        if (wheels < prm->flare_ft && to_aim < 1500.0) {
+            /* the flare takes over the sink rate it finds: h / tau + the touchdown sink */
+            double sink = fmax(-st->vs_fpm / 60.0, prm->flare_sink_fps + 1.0);
+            ls->flare_tau = fmax(prm->flare_tau_min_s, wheels / (sink - prm->flare_sink_fps));
             phase(ls, L_FLARE, ls->seg, st);
+        }
         break;
     case L_FLARE:
-        /* the sink rate falls with the height: an exponential path onto the runway */
+        /* the sink rate falls with the height: an exponential path onto the runway; the
+         * throttle at idle (nav_fcs), the airspeed decays */
         d->alt_ft = st->alt_ft;
-        d->vs_ff_fpm = -60.0 * (fmax(wheels, 0.0) / prm->flare_tau_s + prm->flare_sink_fps);
+        d->ias_kt = prm->flare_ias_kt;
+        d->vs_ff_fpm = -60.0 * (fmax(wheels, 0.0) / ls->flare_tau + prm->flare_sink_fps);
         if (wheels < (isfinite(st->wheels_agl_ft) ? 0.5 : 1.0))
             phase(ls, L_ROLLOUT, ls->seg, st);
         break;
@@ -357,6 +374,7 @@ void mm_leg_step(mm_leg_state_t *ls, const mm_leg_t *L, const rpas_plan_header_t
 {
     const rpas_plan_leg_t *r = &L->raw;
     (void)hdr;
+    ls->note = NULL;
     if (ls->turning_in) {
         /* the fly-by arc ends where its course is the leg's (the tangent point) */
         double end = nf_wrap360(ls->main.crs - 90.0 * ls->seg.dir);
@@ -367,15 +385,21 @@ void mm_leg_step(mm_leg_state_t *ls, const mm_leg_t *L, const rpas_plan_header_t
         }
     }
     mm_track_t tk = mm_track(&ls->seg, st->pos);
-    double alt_target = isfinite(r->alt_ft) ? r->alt_ft : ls->start_alt_ft;
+    bool land = r->type == RPAS_LEG_AUTOLAND; /* its alt_ft is the runway's elevation */
+    double alt_target = isfinite(r->alt_ft) && !land ? r->alt_ft : ls->start_alt_ft;
 
-    d->ias_kt = r->ias_kt;
+    d->ias_kt = land && !isfinite(r->ias_kt) ? prm->approach_ias_kt : r->ias_kt;
     d->alt_ft = alt_target;
     d->vs_ff_fpm = 0.0;
     d->hdg = false;
+    d->centre_k = 0.0;
 
     switch (ls->turning_in ? 0 : r->type) {
     case 0: /* the fly-by arc: the leg's terminator is on its straight */
+        if (land) { /* the glide path is flown from the final's own line */
+            mm_track_t on_final = mm_track(&ls->main, st->pos);
+            land_step(ls, L, prm, st, &on_final, d);
+        }
         break;
     case RPAS_LEG_TF:
     case RPAS_LEG_DF:
@@ -438,9 +462,9 @@ void mm_leg_step(mm_leg_state_t *ls, const mm_leg_t *L, const rpas_plan_header_t
         d->crs_deg = mm_lateral(prm, &ls->seg, &now, st->gs_mps);
         d->hdg = ls->seg.kind == MM_SEG_HDG;
     }
-    if (r->type == RPAS_LEG_AUTOLAND && ls->phase != L_FINAL && !ls->turning_in)
+    if (d->centre_k > 0.0 && !ls->turning_in)
         /* near and on the runway: the centre line held tightly, never more than 10 deg off */
-        d->crs_deg = nf_wrap360(ls->seg.crs - nf_clamp(prm->runway_xte_k * now.xte_m, -10.0, 10.0));
+        d->crs_deg = nf_wrap360(ls->seg.crs - nf_clamp(d->centre_k * now.xte_m, -10.0, 10.0));
     d->xte_m = ls->seg.kind == MM_SEG_LINE || ls->seg.kind == MM_SEG_ARC ? now.xte_m : 0.0;
     d->to_go_m = ls->seg.kind == MM_SEG_LINE ? now.to_go_m : tk.to_go_m;
 

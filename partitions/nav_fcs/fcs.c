@@ -466,7 +466,10 @@ void fcs_step(fcs_t *f, const fcs_inputs_t *in, const rpas_nav_msg_t *nav, int64
         out[0] = f->loops_active ? -f->pitch_i : f->elev;
         out[1] = 0.0;
         out[2] = 0.0;
-        out[3] = f->thr;
+        /* flight termination ordered by the mission manager: the engine is cut all the same */
+        bool cut = in->mission_ok && (in->mission.flags & RPAS_MSN_TERMINATE) &&
+                   age_s(now_ns, in->mission.t_ns) <= p->mission_max_age_s;
+        out[3] = cut ? 0.0 : f->thr;
         f->loops_active = false;
     } else {
         if (!f->loops_active)

@@ -79,8 +79,8 @@
     /* roll-out after a landing */                                                             \
     X(steer_k, 0.08, "rudder (nose-wheel steering) per degree of course error on the ground") \
     X(rollout_elev, -0.1, "elevator on the ground (nose-up: keeps weight off the nose wheel)") \
-    X(brake_gs_kt, 70.0, "brakes only below this ground speed")                               \
-    X(brake_max, 0.8, "wheel brake command on the roll-out")
+    X(brake_gs_kt, 55.0, "brakes only below this ground speed")                               \
+    X(brake_max, 0.5, "wheel brake command on the roll-out")
 
 typedef struct {
 #define FCS_PARAM_FIELD(name, def, doc) double name;

@@ -1,9 +1,11 @@
 # SPDX-License-Identifier: Apache-2.0
 """Scripted traffic and the surveillance receiver that reports it (ADS-B In class).
 
-Each intruder of the script (`traffic:`) appears at `t` at `range_m` on `bearing_deg` (true)
-from where the aircraft is then, `rel_alt_ft` above it, and flies straight and level on
-`track_deg` at `gs_kt` until `until` (else to the end of the flight). The receiver sends one
+Each intruder of the script (`traffic:`) appears at `t` at `range_m` on `bearing_deg` from
+where the aircraft is then, `rel_alt_ft` above it, and flies straight and level on `track_deg`
+at `gs_kt` until `until` (else to the end of the flight). Bearing and track are relative to
+the aircraft's ground track at `t` (bearing 0: dead ahead; track 180: head-on), so that an
+encounter is scripted whatever the route. The receiver sends one
 TRAFFIC frame every `period_ms`: the nearest intruder within `range_m` of the aircraft,
 relative to it (north, east, altitude difference, its track), or none (TFC_VALID 0)."""
 
@@ -33,6 +35,7 @@ class Intruder:
     n0: float = 0.0  # where it appeared, metres north/east of the world's reference
     e0: float = 0.0
     alt0: float = 0.0
+    track_deg: float = 0.0  # true, fixed when it appears
     appeared: bool = False
     active: bool = False
 
@@ -48,11 +51,13 @@ class Traffic:
     def _pos(self, i: Intruder, t_ns: int) -> tuple[float, float, float]:
         dt = (t_ns - i.t0_ns) / NS
         v = i.spec["gs_kt"] * KT
-        trk = math.radians(i.spec["track_deg"])
+        trk = math.radians(i.track_deg)
         return i.n0 + v * dt * math.cos(trk), i.e0 + v * dt * math.sin(trk), i.alt0
 
-    def sample(self, t_ns: int, own_n: float, own_e: float, own_alt_ft: float):
-        """The TRAFFIC frame at t_ns, the aircraft at (own_n, own_e) metres, own_alt_ft."""
+    def sample(self, t_ns: int, own_n: float, own_e: float, own_alt_ft: float,
+               own_track_deg: float):
+        """The TRAFFIC frame at t_ns, the aircraft at (own_n, own_e) metres, own_alt_ft, on
+        own_track_deg."""
         best = None
         for i in self.intruders:
             if t_ns < i.t0_ns:
@@ -63,7 +68,8 @@ class Traffic:
                     self.events.append((t_ns, "traffic", {"state": "gone", **_name(i)}))
                 continue
             if not i.appeared:
-                b = math.radians(i.spec["bearing_deg"])
+                i.track_deg = (own_track_deg + i.spec["track_deg"]) % 360.0
+                b = math.radians(own_track_deg + i.spec["bearing_deg"])
                 i.n0 = own_n + i.spec["range_m"] * math.cos(b)
                 i.e0 = own_e + i.spec["range_m"] * math.sin(b)
                 i.alt0 = own_alt_ft + i.spec.get("rel_alt_ft", 0.0)
@@ -73,7 +79,7 @@ class Traffic:
             n, e, alt = self._pos(i, t_ns)
             d = math.hypot(n - own_n, e - own_e)
             if d <= self.p.range_m and (best is None or d < best[0]):
-                best = (d, n - own_n, e - own_e, alt - own_alt_ft, i.spec["track_deg"])
+                best = (d, n - own_n, e - own_e, alt - own_alt_ft, i.track_deg)
         self.cnt = (self.cnt + 1) & 0x7F
         if best is None:
             return _TRAFFIC.frame_id, _TRAFFIC.encode(0, self.cnt, 0, 0, 0, 0)

@@ -344,7 +344,9 @@ class World:
 
     def _traffic(self, t: int) -> None:
         n, e = self._own_ne()
-        self._send(t, [self.traffic.sample(t, n, e, self.ac.get["alt"]())])
+        g = self.ac.get
+        track = math.degrees(math.atan2(g["ve"](), g["vn"]())) % 360.0
+        self._send(t, [self.traffic.sample(t, n, e, g["alt"](), track)])
         for te, kind, f in self.traffic.events[self._traffic_ev_done:]:
             self.event("traffic", kind, t_ns=te, **f)
         self._traffic_ev_done = len(self.traffic.events)
@@ -463,7 +465,9 @@ class World:
                     self._crash("state is not a number")
                 self._crash("ground contact" if a <= 0.0 else f"roll {r:.1f} deg")
             c, z = cas(), nz()
-            if not c <= lim.max_cas_kt or not abs(z) <= lim.max_load_g:
+            # the load factor counts in the air: on the wheels the gear's springs give spikes
+            on_wheels = ground.touchdown is not None and a < NEAR_GROUND_FT
+            if not c <= lim.max_cas_kt or not (abs(z) <= lim.max_load_g or on_wheels):
                 self._crash(f"airspeed {c:.1f} kt" if not c <= lim.max_cas_kt
                             else f"load factor {z:.1f} g")
             if a < NEAR_GROUND_FT:

@@ -63,7 +63,7 @@ enum rpas_leg_type {
  * | AUTOLAND | runway heading | glide path (deg) | aim point from the threshold (m) | runway length (m) | runway width (m) | |
  *
  * AUTOLAND's alt_ft is the threshold's elevation (ft MSL) and its ias_kt the approach speed
- * (NaN: 65 kt). A leg without a fix (CA, VA) carries latitude and longitude 0. */
+ * (NaN: 70 kt). A leg without a fix (CA, VA) carries latitude and longitude 0. */
 typedef struct {
     uint8_t type;   /* enum rpas_leg_type */
     uint8_t flags;  /* RPAS_LEG_* */

@@ -8,12 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mm.h"
-#include "nf_math.h"
+#include "kinematic.h"
 #include "rpas/unit_check.h"
-
-#define LAT0 47.0
-#define LON0 8.0
 
 /* ---- building plan images ------------------------------------------------------------- */
 
@@ -81,68 +77,6 @@ static void square(image_t *im)
     add(im, RPAS_LEG_TF, -4000, 6000);
     add(im, RPAS_LEG_TF, -4000, 0);
     im->h.n_mission_legs = im->h.n_legs;
-}
-
-/* ---- a kinematic aircraft flying nav_fcs's targets ------------------------------------- */
-
-typedef struct {
-    double n, e, alt, trk, ias;
-    int64_t t;
-    double wind_n, wind_e; /* kt */
-} ac_t;
-
-static void ac_init(ac_t *a)
-{
-    *a = (ac_t){.alt = 3000.0, .trk = 90.0, .ias = 100.0};
-}
-
-/* 50 ms of flight towards the targets: the track turns at up to 5 deg/s (1 per deg of error),
- * the vertical speed is followed at once, the airspeed at 2 kt/s. */
-static void ac_step(ac_t *a, const rpas_mission_msg_t *m)
-{
-    double dt = 0.05;
-    double err = nf_wrap180(m->hdg_deg - a->trk);
-    double rate = nf_clamp(1.0 * err, -5.0, 5.0);
-    a->trk = nf_wrap360(a->trk + rate * dt);
-    a->alt += nf_clamp(m->vs_fpm, -1000.0, 1000.0) / 60.0 * dt;
-    a->ias = nf_rate_limit(a->ias, m->ias_kt, 2.0, dt);
-    double v = a->ias * NF_KT_MPS;
-    a->n += (v * cos(a->trk * NF_DEG) + a->wind_n * NF_KT_MPS) * dt;
-    a->e += (v * sin(a->trk * NF_DEG) + a->wind_e * NF_KT_MPS) * dt;
-    a->t += 50000000;
-}
-
-typedef struct {
-    bool c2_up, gps_ok, fcs_mission, traffic;
-    uint32_t agreed_crc;
-    uint32_t cmd_seq, cmd, cmd_leg;
-    uint32_t fcs_mode;
-} world_t;
-
-static void inputs(const ac_t *a, const world_t *w, mm_inputs_t *in)
-{
-    memset(in, 0, sizeof *in);
-    rpas_nav_msg_t *n = &in->nav;
-    in->nav_ok = true;
-    n->t_ns = a->t;
-    n->flags = RPAS_NAV_AHRS | RPAS_NAV_AIR | (w->gps_ok ? RPAS_NAV_GPS : RPAS_NAV_DR);
-    n->lat_deg = LAT0 + a->n / (NF_DEG * NF_EARTH_R_M);
-    n->lon_deg = LON0 + a->e / (NF_DEG * NF_EARTH_R_M * cos(LAT0 * NF_DEG));
-    n->alt_ft = a->alt;
-    n->ias_kt = a->ias;
-    n->gs_kt = a->ias;
-    n->trk_deg = a->trk;
-    n->hdg_deg = a->trk;
-    in->fcs_ok = true;
-    in->fcs.mode = w->fcs_mode ? w->fcs_mode : (w->fcs_mission ? RPAS_MODE_MISSION : RPAS_MODE_AUTOPILOT);
-    in->pilot_ok = w->c2_up;
-    in->pilot.t_ns = a->t;
-    in->cmd_ok = true;
-    in->cmd = (rpas_mm_cmd_msg_t){.t_ns = a->t, .plan_crc = w->agreed_crc, .cmd_seq = w->cmd_seq,
-                                  .cmd = w->cmd, .leg = w->cmd_leg};
-    in->traffic_ok = true;
-    in->traffic = (rpas_traffic_msg_t){.t_ns = a->t, .valid = w->traffic, .dn_m = 300.0,
-                                       .de_m = 200.0, .dalt_ft = -100.0};
 }
 
 /* Runs the mission manager for `seconds`, the aircraft following it; returns cycles with
@@ -545,6 +479,53 @@ static void test_pilot_commands(void)
     CHECK(hypot(a.n + 4000.0, a.e) < 2000.0);
 }
 
+/* An approach without an airspeed of its own, entered by a fly-by turn: every target nav_fcs
+ * gets is finite (a NaN would make it drop the mission), the glide path is flown down and the
+ * flare flagged. */
+static void test_autoland_targets(void)
+{
+    image_t im;
+    image_init(&im);
+    add(&im, RPAS_LEG_IF, 0, 0);
+    add(&im, RPAS_LEG_TF, -3000, 3000);
+    rpas_plan_leg_t *land = add(&im, RPAS_LEG_AUTOLAND, -3000, 12000); /* the threshold */
+    land->course_deg = 90.0f;
+    land->alt_ft = 500.0f; /* the runway's elevation */
+    land->a = 3.0f, land->b = 300.0f, land->c = 1500.0f, land->d = 30.0f;
+    im.h.n_mission_legs = im.h.n_legs;
+    mm_t mm;
+    mm_init(&mm, NULL);
+    ac_t a;
+    ac_init(&a);
+    a.alt = 1200.0;
+    world_t w = {.c2_up = true, .gps_ok = true, .fcs_mission = true, .agreed_crc = image_crc(&im)};
+    bool finite = true, approach = false, flare = false;
+    double lowest = 1e9;
+    for (int k = 0; k < 20 * 400; k++) {
+        mm_inputs_t in;
+        inputs(&a, &w, &in);
+        if (k == 0) {
+            in.plan = &im;
+            in.plan_len = image_len(&im);
+            in.plan_crc = image_crc(&im);
+        }
+        rpas_mission_msg_t m;
+        rpas_mm_status_msg_t st;
+        if (!mm_step(&mm, &in, a.t, &m, &st)) {
+            a.t += 50000000;
+            continue;
+        }
+        finite = finite && isfinite(m.hdg_deg) && isfinite(m.alt_ft) && isfinite(m.ias_kt) &&
+                 isfinite(m.vs_fpm);
+        approach = approach || (m.flags & RPAS_MSN_APPROACH);
+        flare = flare || (m.flags & RPAS_MSN_FLARE);
+        ac_step(&a, &m);
+        lowest = fmin(lowest, a.alt);
+    }
+    CHECK(finite && approach && flare);
+    CHECK(lowest < 540.0); /* down the glide path to the runway */
+}
+
 static void test_determinism(void)
 {
     image_t im;
@@ -591,6 +572,7 @@ int main(void)
     RUN(test_gps_loss_hold_and_termination);
     RUN(test_traffic_avoidance);
     RUN(test_pilot_commands);
+    RUN(test_autoland_targets);
     RUN(test_determinism);
     return UNIT_RESULT();
 }

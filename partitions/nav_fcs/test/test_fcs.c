@@ -316,6 +316,46 @@ static void test_mission_and_stale_fallback(void)
     CHECK(cmd_in_range(&r.cmd));
 }
 
+/* The landing phases and flight termination the mission manager flags. */
+static void test_landing_flags_and_termination(void)
+{
+    rig_t r;
+    rig_init(&r, RPAS_MODE_MISSION);
+    set_mission(&r, RPAS_MODE_MISSION, 90.0, 3000.0, 58.0);
+    r.in.mission.flags = RPAS_MSN_APPROACH;
+    r.nav.ias_kt = 58.0;
+    mission_steps(&r, 30, true);
+    CHECK(r.st.mode == RPAS_MODE_MISSION && r.st.fallback == RPAS_FB_NONE);
+    CHECK_NEAR(r.st.tgt_ias_kt, 58.0, 1e-9); /* under the usual 65 kt floor */
+    CHECK(!(r.st.env_flags & FCS_ENV_UNDERSPEED)); /* 58 kt is no under-speed on a final */
+    r.in.mission.flags = RPAS_MSN_FLARE;
+    mission_steps(&r, 2, true);
+    CHECK_NEAR(r.cmd.thr, 0.0, 0.0); /* idle */
+    CHECK_NEAR(r.cmd.brake, 0.0, 0.0);
+    /* on the runway: idle, wings level, steering to the course, brakes once slow */
+    r.in.mission.flags = RPAS_MSN_ROLLOUT;
+    r.in.mission.hdg_deg = 95.0;
+    r.nav.gs_kt = 60.0;
+    mission_steps(&r, 1, true);
+    CHECK_NEAR(r.cmd.thr, 0.0, 0.0);
+    CHECK_NEAR(r.cmd.ail, 0.0, 0.0);
+    CHECK(r.cmd.rud > 0.0); /* right, towards 095 */
+    CHECK_NEAR(r.cmd.brake, 0.0, 0.0); /* too fast for the brakes yet */
+    r.nav.gs_kt = 40.0;
+    mission_steps(&r, 1, true);
+    CHECK(r.cmd.brake > 0.4f);
+    /* flight termination: the engine cut, also without attitude */
+    rig_init(&r, RPAS_MODE_MISSION);
+    set_mission(&r, RPAS_MODE_CONTINGENCY, 90.0, 2000.0, 65.0);
+    r.in.mission.flags = RPAS_MSN_TERMINATE;
+    mission_steps(&r, 30, true);
+    CHECK_NEAR(r.cmd.thr, 0.0, 0.0);
+    r.nav.flags = RPAS_NAV_GPS | RPAS_NAV_AIR;
+    mission_steps(&r, 3, true);
+    CHECK(r.st.fallback == RPAS_FB_NAV_INVALID);
+    CHECK_NEAR(r.cmd.thr, 0.0, 0.0);
+}
+
 static void test_nav_invalid(void)
 {
     rig_t r;
@@ -720,6 +760,7 @@ int main(void)
     RUN(test_autopilot_without_targets_holds);
     RUN(test_mission_and_stale_fallback);
     RUN(test_nav_invalid);
+    RUN(test_landing_flags_and_termination);
     RUN(test_heading_wrap);
     RUN(test_limits);
     RUN(test_anti_windup);

@@ -58,6 +58,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     help="the flights timed with and without recording (default 120)")
     tr.add_argument("--pairs", type=positive_int, default=3, metavar="N",
                     help="alternating pairs of flights (default 3)")
+    mis = targets.add_parser(
+        "mission", help="the mission manager: its CPU time per cycle (median, p99, max) "
+        "against its window, and the speed-up of a one-hour mission in the triplex")
+    mis.add_argument("--json", action="store_true", help="print the results as JSON")
+    mis.add_argument("--duration", type=positive_int, default=3600, metavar="SECONDS",
+                     help="the triplex mission's emulated time (default 3600)")
     cmp_ = targets.add_parser(
         "compare", help="a benchmark of this checkout against another checkout (the previous "
         "main), alternating, pinned to one CPU; per-pair ratios and their median")
@@ -95,6 +101,10 @@ def run(args: argparse.Namespace) -> int:
         from ima.bench import campaign
 
         return campaign.run(json_out=args.json, runs_60=args.runs_60, runs_300=args.runs_300)
+    if args.target == "mission":
+        from ima.bench import mission
+
+        return mission.run(json_out=args.json, duration_s=float(args.duration))
     if args.target == "trace":
         from ima.bench import trace
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -64,6 +65,19 @@ def _wrong(text: str) -> tuple[str, str, float, float]:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def _replan(text: str) -> tuple[float, Path]:
+    """--replan SECONDS:PLAN.yaml."""
+    t, sep, path = text.partition(":")
+    try:
+        t_s = float(t)
+    except ValueError:
+        t_s = math.nan
+    if not sep or not path or not 0 < t_s < math.inf:
+        raise argparse.ArgumentTypeError(f"expected SECONDS:PLAN.yaml with SECONDS > 0, not "
+                                         f"'{text}'")
+    return t_s, Path(path)
+
+
 def _port(text: str) -> int:
     return _within(text, int, 0, 65535, "not a port number", "a port is 0..65535")
 
@@ -81,6 +95,10 @@ def add_run_arguments(parser: argparse.ArgumentParser, kind: str = "launch") -> 
                         help="a mission plan (config/missions/): the station uplinks it over "
                         "the C2 link and the mission manager flies it; the summary gains each "
                         "leg's accuracy (docs/mission.md)")
+    parser.add_argument("--replan", type=_replan, action="append", default=[],
+                        metavar="SECONDS:PLAN.yaml",
+                        help="uplink another plan at SECONDS, replacing the plan flown "
+                        "(repeatable; the summary judges the legs of --mission's plan)")
     parser.add_argument("--turbulence", choices=launch_options.TURBULENCE, default="light",
                         help="MIL-F-8785C turbulence (default light)")
     parser.add_argument("--wind", type=wind_kt, default=10.0, metavar="KT",
@@ -169,7 +187,7 @@ def options_from(args: argparse.Namespace, system: Path | None = None,
                  kind: str = "launch") -> launch_options.LaunchOptions:
     return launch_options.LaunchOptions(
         system=system or args.system, duration_s=args.duration, seed=args.seed, pilot=args.pilot,
-        mission=args.mission,
+        mission=args.mission, replan=list(args.replan),
         turbulence=args.turbulence, wind_kt=args.wind, realtime=args.realtime,
         run_dir=args.run_dir, kind=kind, kill=list(args.kill_node), hang=list(args.hang_node),
         wrong_output=list(args.test_wrong_output), netns=args.netns, faults=faults_from(args),

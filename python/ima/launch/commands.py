@@ -79,6 +79,8 @@ def plan(system: System, opts: LaunchOptions, run_dir: Path, sock_dir: Path, pil
                   "--vote-period", f"{system.major_frame_s:g}"]
     if opts.mission is not None:
         world += ["--uplink", f"{MISSION_UPLINK_S:g}:{run_dir / 'mission.img'}"]
+        for k, (t, _) in enumerate(opts.replan, start=1):
+            world += ["--uplink", f"{t:g}:{run_dir / f'mission-{k}.img'}"]
     world += faults.world
     switches = test_switches(opts.test_switches, names)
     world += switches.get("world", [])

@@ -29,6 +29,8 @@ class LaunchOptions:
     pilot: Path | None = None  # default: sim/pilots/default.yaml (fly_mission.yaml with a mission)
     # a mission plan (config/missions/*.yaml): uplinked over C2 at MISSION_UPLINK_S and flown
     mission: Path | None = None
+    # plans uplinked later, replacing the one flown: [(emulated s, plan)]
+    replan: list[tuple[float, Path]] = field(default_factory=list)
     turbulence: str = "light"
     wind_kt: float = 10.0
     wind_from_deg: float = 270.0

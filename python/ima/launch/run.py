@@ -70,18 +70,21 @@ def launch(opts: LaunchOptions, on_status: Callable[[dict], None] | None = None,
         raise ImaError("--netns needs root (it creates network namespaces)")
     pilot = Path(opts.pilot) if opts.pilot else default_pilot(opts.mission is not None)
     pilot_script.load(pilot)  # a bad script is reported before anything starts
-    image = None
+    images: list[bytes] = []
+    if opts.replan and opts.mission is None:
+        raise ImaError("--replan replaces the plan of --mission: give --mission too", exit_code=2)
     if opts.mission is not None:  # a bad plan too
         from ima.mission import image as plan_image
         from ima.mission import plan as mission_plan
 
-        image = plan_image.encode(mission_plan.load(opts.mission))
+        images = [plan_image.encode(mission_plan.load(p))
+                  for p in [opts.mission, *(p for _, p in opts.replan)]]
 
     run_dir = Path(opts.run_dir) if opts.run_dir else new_run_dir(opts.kind, opts.seed)
     outdir.usable_dir(run_dir, "run directory")
     run_dir = run_dir.resolve()  # the nodes run in the socket directory: paths are absolute
-    if image is not None:
-        (run_dir / "mission.img").write_bytes(image)
+    for k, image in enumerate(images):  # the plan, then the replacements (commands.plan)
+        (run_dir / ("mission.img" if k == 0 else f"mission-{k}.img")).write_bytes(image)
     plan = fault_plan.prepare(opts, system, run_dir, launch)
     kills, hangs = plan.kills, plan.hangs
     both = sorted(set(kills) & set(hangs))

@@ -5,7 +5,13 @@ altitude (truth.jsonl against ima.mission.geometry), the contingencies it declar
 procedures and the mission's resumption, and the landing.
 
 Leg statistics count from the leg's capture: the first truth sample within CAPTURE_M of the
-planned path (a leg begins where the turn from the previous one begins, off its path). The
+planned path with the track within CAPTURE_DEG of the path's course there (a leg begins where
+the turn from the previous one begins, off its path, and may cross it while turning: the
+aircraft is established once close and aligned). A hold is judged on its racetrack, once the
+mission manager reports the entry flown. CA and VA have no path of their own (a course or a
+heading until an altitude): they are judged on their course and their terminator. A scan is judged pass by pass: the samples
+flying along a pass (within 30 degrees of its course, beside it by less than half the spacing,
+between its ends), each pass from its own capture. The
 altitude is judged where the plan holds one (a level leg, a geometric path) from the first
 sample within CAPTURE_ALT_M of it; a climb or descent at constant airspeed is judged after it
 has levelled off at the constraint."""
@@ -23,7 +29,10 @@ import numpy as np
 from ima.mission.geometry import FT, LegPath, leg_paths
 from ima.mission.plan import Plan
 
-CAPTURE_M = 50.0
+CAPTURE_M = 15.0
+CAPTURE_DEG = 10.0
+_RACETRACK = re.compile(r"mission_manager: leg (\d+) hold: (\w+) entry flown")
+PASS_TRACK_DEG = 30.0
 AUTOLAND_JUDGED_ABOVE_FT = 50.0
 CAPTURE_ALT_M = 15.0
 _STATE = re.compile(r"mission_manager: ([A-Z_]+) leg (-?\d+) (\S+)$")
@@ -95,7 +104,7 @@ def contingencies(msgs: list[tuple[int, str]]) -> list[dict]:
 
 
 def load_truth(path: Path) -> dict[str, np.ndarray]:
-    cols = ("t_ns", "lat_deg", "lon_deg", "alt_ft", "agl_ft", "airspeed_kt", "gs_kt")
+    cols = ("t_ns", "lat_deg", "lon_deg", "alt_ft", "agl_ft", "airspeed_kt", "gs_kt", "track_deg")
     rows = []
     if Path(path).is_file():
         with open(path, encoding="utf-8", errors="replace") as f:
@@ -124,6 +133,20 @@ def _along(points: np.ndarray, q: np.ndarray) -> np.ndarray:
     return start[k] + t[np.arange(len(q)), k] * seg[k]
 
 
+def _course_err(points: np.ndarray, q: np.ndarray, track_deg: np.ndarray) -> np.ndarray:
+    """|track - the course of the polyline's nearest segment| (deg) of each position."""
+    if len(points) < 2 or not len(q):
+        return np.zeros(len(q))
+    a, b = points[:-1], points[1:]
+    ab = b - a
+    den = np.maximum((ab * ab).sum(axis=1), 1e-12)
+    t = np.clip(((q[:, None, :] - a) * ab).sum(axis=2) / den, 0.0, 1.0)
+    near = a + t[..., None] * ab
+    k = np.hypot(*(q[:, None, :] - near).transpose(2, 0, 1)).argmin(axis=1)
+    crs = np.degrees(np.arctan2(ab[k, 1], ab[k, 0]))
+    return np.abs((track_deg - crs + 180.0) % 360.0 - 180.0)
+
+
 def _p95(x: np.ndarray) -> float | None:
     return round(float(np.percentile(x, 95)), 2) if len(x) else None
 
@@ -132,12 +155,36 @@ def _max(x: np.ndarray) -> float | None:
     return round(float(np.max(x)), 2) if len(x) else None
 
 
+def pass_stats(path: LegPath, ne: np.ndarray, track_deg: np.ndarray) -> list[dict]:
+    """A scan's passes, each judged on the samples flying along it, from its capture."""
+    out = []
+    spacing = (float(np.hypot(*(path.passes[1][0] - path.passes[0][1])))
+               if len(path.passes) > 1 else 400.0)
+    for k, (a, b) in enumerate(path.passes):
+        u = (b - a) / max(float(np.hypot(*(b - a))), 1e-9)
+        rel = ne - a
+        along = rel @ u
+        across = rel @ np.array([-u[1], u[0]])
+        crs = np.degrees(np.arctan2(u[1], u[0]))
+        aligned = np.abs((track_deg - crs + 180.0) % 360.0 - 180.0) <= PASS_TRACK_DEG
+        on = aligned & (np.abs(across) < spacing / 2) & (along >= 0.0) & \
+            (along <= float(np.hypot(*(b - a))))
+        x = np.abs(across[on])
+        cap = np.flatnonzero(x <= CAPTURE_M)
+        after = x[cap[0]:] if len(cap) else x
+        out.append({"pass": k, "samples": int(on.sum()), "captured": bool(len(cap)),
+                    "xte_m_p95": _p95(after), "xte_m_max": _max(after)})
+    return out
+
+
 def leg_stats(path: LegPath, geometric: bool, ne: np.ndarray, alt_ft: np.ndarray,
-              ias: np.ndarray, t_ns: np.ndarray) -> dict:
+              ias: np.ndarray, t_ns: np.ndarray, track_deg: np.ndarray | None = None) -> dict:
     """One leg's accuracy over its samples (ne: local positions); `geometric`: its altitude
     is a geometric path (else a climb or descent is judged once levelled off)."""
     xte = path.distance_to(ne) if len(ne) else np.zeros(0)
-    cap = np.flatnonzero(xte <= CAPTURE_M)
+    aligned = (_course_err(path.points, ne, track_deg) <= CAPTURE_DEG
+               if track_deg is not None else np.ones(len(ne), bool))
+    cap = np.flatnonzero((xte <= CAPTURE_M) & aligned)
     captured = len(cap) > 0
     after = xte[cap[0]:] if captured else xte
     # the planned altitude: the profile along the leg proper (the entry is not flown as such)
@@ -148,7 +195,15 @@ def leg_stats(path: LegPath, geometric: bool, ne: np.ndarray, alt_ft: np.ndarray
     err_m = np.abs(alt_ft - ref) * FT if len(ne) else np.zeros(0)
     acap = np.flatnonzero(err_m <= CAPTURE_ALT_M)
     alt_after = err_m[acap[0]:] if len(acap) else np.zeros(0)
-    return {
+    passes = None
+    if path.type == "SCAN" and len(path.passes) and track_deg is not None:
+        passes = pass_stats(path, ne, track_deg)
+        flown_passes = [p for p in passes if p["xte_m_p95"] is not None]
+        if flown_passes:
+            after = np.array([max(p["xte_m_p95"] for p in flown_passes)])
+            xmax = max(p["xte_m_max"] for p in flown_passes)
+            captured = all(p["captured"] for p in passes)
+    out = {
         "index": path.index, "type": path.type, "label": path.label,
         "t_start_s": round(t_ns[0] / 1e9, 2) if len(t_ns) else None,
         "t_end_s": round(t_ns[-1] / 1e9, 2) if len(t_ns) else None,
@@ -158,6 +213,32 @@ def leg_stats(path: LegPath, geometric: bool, ne: np.ndarray, alt_ft: np.ndarray
         "ias_kt_min": round(float(np.nanmin(ias)), 1) if len(ias) else None,
         "ias_kt_max": round(float(np.nanmax(ias)), 1) if len(ias) else None,
     }
+    if passes is not None:
+        out["passes"] = passes
+        if flown_passes:
+            out["xte_m_p95"], out["xte_m_max"] = round(float(after[0]), 2), xmax
+    if path.type in ("CA", "VA"):  # no path: a course (CA) or a heading (VA) to an altitude
+        out["xte_m_p95"] = out["xte_m_max"] = None
+        out["captured"] = None
+    return out
+
+
+def terminator(path: LegPath, leg, ne: np.ndarray, alt_ft: np.ndarray, track_deg: np.ndarray,
+               fix_ne: np.ndarray | None) -> dict:
+    """Where the leg ended against its terminator: the altitude reached (CA, FA, VA, HA), the
+    fix passed (the closest the aircraft came to it, over the leg and the next one's first
+    minute: a fly-by turn passes inside it), the course at the end (CF, DUBINS)."""
+    out: dict = {}
+    if not len(ne):
+        return out
+    if path.type in ("CA", "FA", "VA", "HA") and leg.altitude_ft is not None:
+        out["end_alt_err_ft"] = round(float(alt_ft[-1] - leg.altitude_ft), 1)
+    if fix_ne is not None and path.type in ("TF", "DF", "CF", "RF", "DIRECT", "DUBINS"):
+        out["fix_miss_m"] = round(float(np.min(np.hypot(*(ne - fix_ne).T))), 1)
+    if path.type in ("CF", "DUBINS") and path.end_course_deg is not None:
+        out["end_course_err_deg"] = round(float(abs((track_deg[-1] - path.end_course_deg + 180.0)
+                                                    % 360.0 - 180.0)), 1)
+    return out
 
 
 def world_events(run_dir: Path, kinds: set[str]) -> list[dict]:
@@ -240,12 +321,34 @@ def judge(run_dir: Path, plan: Plan, node: str) -> dict:
             continue  # a leg made up in flight (a hold, a direct-to) on the leg's number
         mask = (t >= iv.t0_ns) & (t < iv.t1_ns)
         flown[iv.leg] = mask if iv.leg not in flown else flown[iv.leg] | mask
+    racetrack = {}
+    for tr_ns, text in msgs:
+        if (mt := _RACETRACK.match(text)) and int(mt.group(1)) not in racetrack:
+            racetrack[int(mt.group(1))] = tr_ns
+    image_legs = [leg for leg, _ in plan.image_legs()]
     for idx in sorted(flown):
         m = flown[idx]
-        if by_index[idx].type == "AUTOLAND":  # the touchdown criteria judge below 50 ft
+        path, leg = by_index[idx], image_legs[idx]
+        whole = m
+        if path.type == "AUTOLAND":  # the touchdown criteria judge below 50 ft
             m = m & (truth["agl_ft"] >= AUTOLAND_JUDGED_ABOVE_FT)
-        legs.append(leg_stats(by_index[idx], geometric[idx], ne_all[m], truth["alt_ft"][m],
-                              truth["airspeed_kt"][m], t[m]))
+        if path.type in ("HA", "HF", "HM"):  # the racetrack, once the entry is flown
+            m = m & (t >= racetrack.get(idx, np.inf))
+        stats = leg_stats(path, geometric[idx], ne_all[m], truth["alt_ft"][m],
+                          truth["airspeed_kt"][m], t[m], truth["track_deg"][m])
+        if path.type in ("HA", "HF", "HM"):
+            stats["entry"] = next((tx.split("hold: ")[1].split(" ")[0] for tn, tx in msgs
+                                   if tn == racetrack.get(idx) and "hold:" in tx), None)
+        # the terminator: over the leg and, for a fix, the next leg's first minute
+        k = np.flatnonzero(whole)
+        ext = whole.copy()
+        if len(k):
+            ext[k[-1]:min(k[-1] + 600, len(t))] = True
+        fix_ne = (frame.to_local(plan.waypoints[leg.fix].lat_deg, plan.waypoints[leg.fix].lon_deg)
+                  if leg.fix in plan.waypoints else None)
+        stats.update(terminator(path, leg, ne_all[ext if fix_ne is not None else whole],
+                                truth["alt_ft"][whole], truth["track_deg"][whole], fix_ne))
+        legs.append(stats)
     final = ivs[-1] if ivs else None
     return {
         "mission": {"plan": plan.name, "plan_id": plan.plan_id, "node": node,

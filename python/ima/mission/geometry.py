@@ -453,8 +453,10 @@ class _Builder:
         k = max(1, math.ceil(sweep / ARC_STEP_DEG))
         pts = [fix + r * unit(b0 + side * sweep * i / k) for i in range(k + 1)]
         laps = None if leg.time_s is not None else (leg.laps or 1)
+        # where the orbit ends on its circle depends on how it was joined: the next leg
+        # starts from the orbit's fix (as the mission manager flies it)
         out.update(kind="arc", points=pts, entry=self._entry(st, start),
-                   length=r * math.radians(sweep), end=pts[-1],
+                   length=r * math.radians(sweep), end=fix,
                    course=(b0 + side * (sweep + 90.0)) % 360.0, radius=r, center=fix, laps=laps)
 
     def _scan(self, leg, st, fix, out, tas, **_):

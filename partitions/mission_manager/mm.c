@@ -255,6 +255,19 @@ static void start_synth(mm_t *mm, int type, mm_vec_t p, double course, double al
     mm->ls.leg = keep;
 }
 
+/* A direct to leg i's fix (a rejoin, a pilot's direct-to): then on with leg i + 1, by a
+ * fly-by turn onto it. */
+static void direct_to(mm_t *mm, int i, const mm_state_t *st)
+{
+    const mm_leg_t *L = &mm->plan.leg[i];
+    start_synth(mm, RPAS_LEG_DIRECT, L->fix, 0.0,
+                isfinite(L->raw.alt_ft) ? L->raw.alt_ft : mm->alt_ref_ft, st);
+    mm->synth.raw.flags = 0;
+    if (i + 1 < mm->plan.hdr.n_mission_legs)
+        mm->synth.next_crs = leaving_course(&mm->plan.leg[i + 1], L->fix);
+    mm->ls.leg = i;
+}
+
 /* The first leg after the plan's IFs, from `i` (flyby: see start_leg). */
 static void sequence_from(mm_t *mm, int i, int end, const mm_state_t *st, bool flyby)
 {
@@ -318,10 +331,7 @@ static void pilot_command(mm_t *mm, const rpas_mm_cmd_msg_t *c, const mm_state_t
         if (c->leg < mm->plan.hdr.n_mission_legs && has_fix(mm->plan.leg[c->leg].raw.type) &&
             mm->state != RPAS_MM_CONTINGENCY) {
             mm->state = mm->engaged ? RPAS_MM_ACTIVE : RPAS_MM_STANDBY;
-            start_synth(mm, RPAS_LEG_DIRECT, mm->plan.leg[c->leg].fix, 0.0,
-                        isfinite(mm->plan.leg[c->leg].raw.alt_ft) ? mm->plan.leg[c->leg].raw.alt_ft
-                                                                  : mm->alt_ref_ft, st);
-            mm->ls.leg = (int)c->leg; /* after the direct-to: the leg after it */
+            direct_to(mm, (int)c->leg, st); /* then the leg after it */
             EVENT("direct to leg %d", (int)c->leg);
         }
         break;
@@ -444,9 +454,7 @@ static void rejoin(mm_t *mm, int i, const mm_state_t *st)
     const mm_leg_t *L = &mm->plan.leg[i];
     int t = L->raw.type;
     if (t == RPAS_LEG_TF || t == RPAS_LEG_DF || t == RPAS_LEG_CF || t == RPAS_LEG_RF) {
-        start_synth(mm, RPAS_LEG_DIRECT, L->fix, 0.0,
-                    isfinite(L->raw.alt_ft) ? L->raw.alt_ft : mm->alt_ref_ft, st);
-        mm->ls.leg = i;
+        direct_to(mm, i, st);
     } else {
         start_leg(mm, i, st, false);
     }
@@ -483,7 +491,9 @@ static void next_leg(mm_t *mm, const mm_state_t *st)
                 return; /* the procedure's last leg: it stays on it */
         }
     }
-    sequence_from(mm, mm->ls.leg + 1, end, st, !synth);
+    /* after a direct-to, a fly-by onto the next leg too */
+    sequence_from(mm, mm->ls.leg + 1, end, st,
+                  !synth || (mm->synth.raw.type == RPAS_LEG_DIRECT && isfinite(mm->synth.next_crs)));
 }
 
 static bool state_from_nav(const mm_t *mm, const mm_inputs_t *in, int64_t now, mm_state_t *st)

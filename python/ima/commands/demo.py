@@ -12,7 +12,7 @@ from ima import paths
 from ima.commands import launch
 from ima.launch.options import system_path
 
-DEMO_DURATION_S = 1500.0  # the landing and the stop are in by about 1420 s
+DEMO_DURATION_S = 1750.0  # the landing and the stop are in by about 1700 s
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:

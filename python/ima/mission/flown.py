@@ -9,10 +9,10 @@ planned path with the track within CAPTURE_DEG of the path's course there (a leg
 the turn from the previous one begins, off its path, and may cross it while turning: the
 aircraft is established once close and aligned). A hold is judged on its racetrack, once the
 mission manager reports the entry flown. CA and VA have no path of their own (a course or a
-heading until an altitude): they are judged on their course and their terminator. A scan is judged pass by pass: the samples
-flying along a pass (within 30 degrees of its course, beside it by less than half the spacing,
-between its ends), each pass from its own capture. The
-altitude is judged where the plan holds one (a level leg, a geometric path) from the first
+heading until an altitude): they are judged on their terminator. A scan is judged pass by
+pass: the samples flying along a pass (within 30 degrees of its course, beside it by less
+than half the spacing, between its ends), each pass from its own capture. The altitude is
+judged where the plan holds one (a level leg, a geometric path) from the first
 sample within CAPTURE_ALT_M of it; a climb or descent at constant airspeed is judged after it
 has levelled off at the constraint."""
 

@@ -471,7 +471,9 @@ void mm_leg_step(mm_leg_state_t *ls, const mm_leg_t *L, const rpas_plan_header_t
     /* a geometric path: from the leg's start altitude to the constraint over the leg's length */
     if ((r->flags & RPAS_LEG_ALT_PATH) && isfinite(r->alt_ft) && ls->path_len_m > 1.0 &&
         r->type != RPAS_LEG_AUTOLAND) {
-        double f = nf_clamp(now.along_m / ls->path_len_m, 0.0, 1.0);
+        /* along the leg's own straight, also while the fly-by arc onto it is flown */
+        mm_track_t on_leg = ls->turning_in ? mm_track(&ls->main, st->pos) : now;
+        double f = nf_clamp(on_leg.along_m / ls->path_len_m, 0.0, 1.0);
         double grad = (r->alt_ft - ls->start_alt_ft) / ls->path_len_m; /* ft per m */
         d->alt_ft = ls->start_alt_ft + (r->alt_ft - ls->start_alt_ft) * f;
         d->vs_ff_fpm = f < 1.0 ? grad * st->gs_mps * 60.0 : 0.0;

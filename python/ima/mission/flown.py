@@ -217,7 +217,9 @@ def leg_stats(path: LegPath, geometric: bool, ne: np.ndarray, alt_ft: np.ndarray
         out["passes"] = passes
         if flown_passes:
             out["xte_m_p95"], out["xte_m_max"] = round(float(after[0]), 2), xmax
-    if path.type in ("CA", "VA"):  # no path: a course (CA) or a heading (VA) to an altitude
+    # no path: a course (CA) or a heading (VA) to an altitude; a procedure's direct-to from
+    # wherever the aircraft is (its planned path is its fix alone)
+    if path.type in ("CA", "VA") or len(path.points) < 2:
         out["xte_m_p95"] = out["xte_m_max"] = None
         out["captured"] = None
     return out

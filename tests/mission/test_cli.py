@@ -29,10 +29,10 @@ def test_mission_is_a_registered_command():
 def test_check_prints_the_legs_the_contingencies_and_the_image(capsys):
     assert cli.main(["mission", "check", str(MISSIONS / "demo.yaml")]) == 0
     out = capsys.readouterr().out
-    for text in ("AUTOLAND", "RWY09", "SCAN", "4 passes of 2500 m, 400 m apart", "c2_loss",
+    for text in ("AUTOLAND", "RWY27", "SCAN", "4 passes of 2500 m, 400 m apart", "c2_loss",
                  "terminate", "geometric", "Mission: "):
         assert text in out, text
-    size = 200 + 48 * 10
+    size = 200 + 48 * 11
     assert f"image: {size} bytes, crc32 0x" in out
 
 
@@ -42,11 +42,11 @@ def test_check_json_one_object_per_plan(capsys):
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 2
     demo, square = (json.loads(line) for line in lines)
-    assert demo["mission"] == "demo" and demo["image"]["bytes"] == 680
+    assert demo["mission"] == "demo" and demo["image"]["bytes"] == 728
     assert demo["image"]["crc32"].startswith("0x") and len(demo["image"]["crc32"]) == 10
     assert [leg["type"] for leg in square["legs"]] == ["IF", "TF", "TF", "TF", "TF"]
     assert square["length_m"] == pytest.approx(16000, abs=1)
-    assert demo["contingencies"]["c2_loss"]["legs"] == [8, 9]
+    assert demo["contingencies"]["c2_loss"]["legs"] == [9, 10]
     assert 20 * 60 < demo["duration_s"] < 35 * 60
 
 

@@ -155,13 +155,13 @@ def test_arcs():
 def test_the_final_and_the_vertical_profile():
     p = plan.load(MISSIONS / "demo.yaml")
     paths = geometry.leg_paths(p)
-    final, faf = paths[7], paths[6]
-    rw = p.runways["RWY09"]
+    final, faf = paths[8], paths[7]
+    rw = p.runways["RWY27"]
     thr = geometry.Frame(47, 8).to_local(rw.lat_deg, rw.lon_deg)
     # the glide path meets 2000 ft 8724 m before the aim point: over the FAF
     assert np.hypot(*(final.points[0] - faf.points[-1])) < 1.0
     assert np.allclose(final.points[1], thr) and final.points[2] == pytest.approx(
-        thr + [0, 1500])
+        thr + [0, -1500])
     at_thr = final.altitude_at(np.hypot(*(thr - final.points[0])))
     assert at_thr == pytest.approx(500 + 300 * math.tan(math.radians(3)) / 0.3048)
     assert final.altitude_at(final.length_m) == 500
@@ -171,9 +171,9 @@ def test_the_final_and_the_vertical_profile():
     assert prof.altitude_ft[0] == 3000 and prof.altitude_ft[-1] == 500
     assert np.all(np.diff(prof.distance_m) >= 0)
     assert list(prof.leg_start_m) == [x.index for x in mission]
-    # the FAF's TF is a geometric path: a straight line from 3000 to 2000 ft
+    # the FAF's TF (the base leg) is a geometric path: a straight line from 2500 to 2000 ft
     mid = faf.total_m / 2
-    assert faf.altitude_at(mid) == pytest.approx(2500)
+    assert faf.altitude_at(mid) == pytest.approx(2250)
     # a constant-airspeed climb is at max_vs_fpm, then level
     tf1 = paths[1]
     climb_m = 500 / (800 / (tf1.tas_kt * KT * 60))

@@ -64,6 +64,26 @@ def _legs_flown(m: dict, legs: list[dict]) -> str:
     return f"{flown}/{planned} legs flown" + (f" (and {extra} of procedures)" if extra else "")
 
 
+def _print_landing(a: dict | None, console) -> None:
+    """The automatic landing's outcome (ima.mission.flown.autoland), one or two lines."""
+    if not a:
+        return
+    if a.get("crashed"):
+        console.print(f"Landing on {a['runway']}: crashed ({a.get('crash_reason')})",
+                      markup=False)
+        return
+    if not a.get("landed"):
+        console.print(f"Landing on {a['runway']}: not reached in the flight", markup=False)
+        return
+    stop = ("stopped {:.0f} m from the threshold{}".format(
+        a["stop_from_threshold_m"], ", on the runway" if a["stopped_on_runway"] else
+        ", OFF the runway") if a.get("stopped") else "not stopped by the end of the flight")
+    console.print(f"Landing on {a['runway']}: touchdown at {a['touchdown_t_s']:.1f} s, "
+                  f"{a['touchdown_from_aim_m']:+.0f} m from the aim point, "
+                  f"{a['centerline_m']:.1f} m off the centre line, sink {a['sink_fps']:.1f} "
+                  f"ft/s, {'bounced' if a['bounced'] else 'no bounce'}; {stop}", markup=False)
+
+
 def print_mission(s: dict, console) -> None:
     """The mission flown (ima.mission.flown.judge): each leg's accuracy, the contingencies,
     the track's PNG."""
@@ -113,6 +133,7 @@ def print_mission(s: dict, console) -> None:
         console.print(t)
     else:
         console.print("Contingencies: none declared")
+    _print_landing(s.get("autoland"), console)
     if s.get("track_png"):
         console.print(f"track: {s['track_png']}", markup=False)
     elif s.get("track_error"):

@@ -126,7 +126,8 @@ def planned_altitude(plan: Plan, paths: list[LegPath], ivs: list[flown.Interval]
     no leg of the plan is flown (no report, a hold or direct-to made up in flight)."""
     out = np.full(len(t_ns), np.nan)
     by_index = {p.index: p for p in paths}
-    geometric = {i: leg.geometric for i, (leg, _) in enumerate(plan.image_legs())}
+    geometric = {i: leg.geometric or leg.type == "AUTOLAND"  # the glide path
+                 for i, (leg, _) in enumerate(plan.image_legs())}
     for iv in ivs:
         path = by_index.get(iv.leg)
         if iv.state not in FLYING or path is None or iv.type != path.type:

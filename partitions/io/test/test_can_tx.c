@@ -52,6 +52,36 @@ static void test_frames_on_the_node_channel(void)
     CHECK(io_tx_frames(&o, 2, 5, f, sent) == 2);
 }
 
+/* The mission manager's status every other frame; wheel brakes only while nav_fcs brakes. */
+static void test_mission_status_and_brakes(void)
+{
+    io_outputs_t o = outputs();
+    o.have_mm = true;
+    o.mm = (rpas_mm_status_msg_t){.state = RPAS_MM_CONTINGENCY, .contingency = RPAS_CT_C2_LOSS,
+                                  .ct_flags = 1, .leg = 7, .phase = 2, .to_go_m = 1234.4,
+                                  .xte_m = -12.34};
+    io_frame_t f[IO_TX_MAX_FRAMES];
+    double sent[IO_AXES] = {0};
+    CHECK(io_tx_frames(&o, 1, 4, f, sent) == 5);
+    CHECK(f[4].id == RPAS_CAN_MISSION_STATUS_B_FRAME_ID);
+    struct rpas_can_mission_status_a_t m;
+    CHECK(rpas_can_mission_status_a_unpack(&m, f[4].data, 8) == 0);
+    CHECK(m.ms_state_a == RPAS_MM_CONTINGENCY && m.ms_ct_a == RPAS_CT_C2_LOSS && m.ms_leg_a == 7);
+    CHECK(m.ms_phase_a == 2 && m.ms_ct_flags_a == 1);
+    CHECK_NEAR(rpas_can_mission_status_a_ms_xte_a_decode(m.ms_xte_a), -12.3, 0.06);
+    CHECK_NEAR(rpas_can_mission_status_a_ms_togo_a_decode(m.ms_togo_a), 1234, 0.6);
+    o.mm.state = RPAS_MM_NO_PLAN, o.mm.contingency = 255, o.mm.leg = -1;
+    io_tx_frames(&o, 1, 4, f, sent);
+    CHECK(rpas_can_mission_status_a_unpack(&m, f[4].data, 8) == 0);
+    CHECK(m.ms_ct_a == 15 && m.ms_leg_a == 255); /* none */
+    o.cmd.brake = 0.5f;
+    CHECK(io_tx_frames(&o, 1, 5, f, sent) == 3);
+    CHECK(f[1].id == RPAS_CAN_BRAKE_CMD_B_FRAME_ID);
+    struct rpas_can_brake_cmd_a_t b;
+    CHECK(rpas_can_brake_cmd_a_unpack(&b, f[1].data, 8) == 0);
+    CHECK_NEAR(rpas_can_brake_cmd_a_brk_cmd_a_decode(b.brk_cmd_a), 0.5, 1e-3);
+}
+
 static void test_clamped(void)
 {
     io_outputs_t o = outputs();
@@ -128,6 +158,7 @@ static void test_telemetry(void)
 int main(void)
 {
     RUN(test_frames_on_the_node_channel);
+    RUN(test_mission_status_and_brakes);
     RUN(test_clamped);
     RUN(test_nothing_to_send);
     RUN(test_faults_on_the_command);

@@ -14,6 +14,7 @@
 #include "ARINC653.h"
 #include "fdr.h"
 #include "fdr_ports.h"
+#include "rpas/port.h"
 #include "rpas/process.h"
 #include "rpas/report.h"
 
@@ -121,17 +122,7 @@ int main(int argc, char **argv)
     }
     for (int p = 0; p < P_COUNT; p++) {
         const rpas_port_spec_t *ps = &fdr_port_spec[p];
-        if (ps->kind == RPAS_PORT_QUEUING) {
-            QUEUING_PORT_ID_TYPE id;
-            CREATE_QUEUING_PORT(ps->name, ps->size, ps->max_nb_messages, ps->direction, FIFO,
-                                &id, &rc);
-            app.ids[p] = (long)id;
-        } else {
-            SAMPLING_PORT_ID_TYPE id;
-            CREATE_SAMPLING_PORT((char *)ps->name, ps->size, ps->direction, ps->refresh_ns, &id,
-                                 &rc);
-            app.ids[p] = (long)id;
-        }
+        rpas_create_port(ps, &app.ids[p], &rc);
         if (rc != NO_ERROR) {
             fail(ps->name, rc);
             return 1;

@@ -72,7 +72,7 @@ typedef struct {
     uint8_t plan[RPAS_PLAN_MAX_BYTES];
     uint32_t plan_len, plan_crc;
     bool plan_new; /* to be sent to the mission manager */
-    uint64_t refused;
+    uint64_t refused; /* uploads refused (a bad announcement, a CRC that fails) */
 } io_uplink_t;
 
 void io_uplink_init(io_uplink_t *u);

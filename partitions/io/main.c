@@ -17,6 +17,7 @@
 #include "canbus/client.h"
 #include "io_core.h"
 #include "io_ports.h"
+#include "rpas/port.h"
 #include "rpas/process.h"
 #include "rpas/report.h"
 #include "xch/client.h"
@@ -195,8 +196,9 @@ static void mission_uplink(int64_t t)
         [IO_UPLINK_BAD_CRC] = "refused: CRC mismatch, the plan held is kept",
         [IO_UPLINK_BAD_HEADER] = "refused: bad length"};
     if (io.rx.uplink_event != IO_UPLINK_NONE)
-        rpas_report("io: mission plan 0x%08x (%u bytes) %s", (unsigned)u->crc, (unsigned)u->len,
-                    what[io.rx.uplink_event]);
+        rpas_report("io: mission plan 0x%08x (%u bytes) %s (%llu refused so far)",
+                    (unsigned)u->crc, (unsigned)u->len, what[io.rx.uplink_event],
+                    (unsigned long long)u->refused);
     if (u->plan_new) {
         static uint8_t msg[8 + RPAS_PLAN_MAX_BYTES];
         memcpy(msg, &u->plan_crc, 4);
@@ -339,16 +341,7 @@ int main(int argc, char *argv[])
     RETURN_CODE_TYPE rc;
     for (int p = 0; p < IO_PORT_COUNT; p++) {
         const rpas_port_spec_t *s = &io_port_spec[p];
-        if (s->kind == RPAS_PORT_QUEUING) {
-            QUEUING_PORT_ID_TYPE id;
-            CREATE_QUEUING_PORT((char *)s->name, s->size, s->max_nb_messages, s->direction, FIFO,
-                                &id, &rc);
-            io.port[p] = id;
-        } else {
-            SAMPLING_PORT_ID_TYPE id;
-            CREATE_SAMPLING_PORT((char *)s->name, s->size, s->direction, s->refresh_ns, &id, &rc);
-            io.port[p] = id;
-        }
+        rpas_create_port(s, &io.port[p], &rc);
         if (rc != NO_ERROR)
             return fail(s->name, rc);
     }

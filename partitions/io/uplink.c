@@ -30,6 +30,9 @@ int io_uplink_segment(io_uplink_t *u, unsigned seg, unsigned cnt, uint64_t data)
         uint32_t crc = (uint32_t)(data >> 16);
         if (len < sizeof(rpas_plan_header_t) || len > RPAS_PLAN_MAX_BYTES) {
             u->receiving = false;
+            u->cnt = cnt; /* as announced, for the report */
+            u->len = len;
+            u->crc = crc;
             u->refused++;
             return IO_UPLINK_BAD_HEADER;
         }

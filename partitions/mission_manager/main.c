@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The mission manager's APEX main: each period it takes the plan io reassembled from the
  * uplink (queuing port PLAN_IN), reads its node's navigation solution, flight-control status,
- * the pilot's uplink, io's plan agreement and commands and the traffic report, runs the core
+ * the pilot's uplink, io's plan agreement and commands, the traffic report and the radar
+ * altimeter, runs the core
  * (mm.c) and writes the targets for nav_fcs (MISSION_OUT) and its status for the downlink
  * (MM_STATUS_OUT). Its ports and process come from the contract generated from the model. */
 #include <stdio.h>
@@ -10,6 +11,7 @@
 #include "ARINC653.h"
 #include "mission_manager_ports.h"
 #include "mm.h"
+#include "rpas/port.h"
 #include "rpas/process.h"
 #include "rpas/report.h"
 
@@ -26,7 +28,7 @@ enum {
     P_COUNT = MISSION_MANAGER_PORT_COUNT
 };
 
-/* PLAN_IN's message: the plan's CRC-32 as the uplink gave it, then the image. */
+/* PLAN_IN's message: the plan's CRC-32 as the uplink gave it, its length, then the image. */
 #define PLAN_MSG_MAX (8 + RPAS_PLAN_MAX_BYTES)
 
 static struct {
@@ -39,20 +41,21 @@ static struct {
 static bool read_port(int p, void *msg)
 {
     unsigned char buf[128];
+    _Static_assert(sizeof(rpas_pilot_msg_t) <= sizeof buf && sizeof(rpas_nav_msg_t) <= sizeof buf,
+                   "read_port's buffer holds every message the mission manager reads");
     MESSAGE_SIZE_TYPE len = 0;
     VALIDITY_TYPE v = INVALID;
     RETURN_CODE_TYPE rc;
     READ_SAMPLING_MESSAGE((SAMPLING_PORT_ID_TYPE)app.id[p], (MESSAGE_ADDR_TYPE)buf, &len, &v, &rc);
-    if (rc != NO_ERROR || len != mission_manager_port_spec[p].size || (size_t)len > sizeof buf)
+    if (rc != NO_ERROR || len != mission_manager_port_spec[p].size)
         return false;
     memcpy(msg, buf, (size_t)len);
     return v == VALID;
 }
 
-/* The newest plan in the queue (older ones are superseded), or none. */
-static bool receive_plan(void)
+/* The newest plan in the queue (older ones are superseded), or none (in->plan NULL). */
+static void receive_plan(void)
 {
-    bool got = false;
     for (;;) {
         MESSAGE_SIZE_TYPE len = 0;
         RETURN_CODE_TYPE rc;
@@ -65,9 +68,7 @@ static bool receive_plan(void)
         memcpy(&app.in.plan_crc, app.plan_msg, 4);
         app.in.plan = app.plan_msg + 8;
         app.in.plan_len = (size_t)len - 8;
-        got = true;
     }
-    return got;
 }
 
 static void cycle(void)
@@ -81,7 +82,7 @@ static void cycle(void)
         mm_inputs_t *in = &app.in;
         in->nav_ok = read_port(P_NAV, &in->nav);
         in->fcs_ok = read_port(P_STATUS, &in->fcs);
-        in->pilot_ok = read_port(P_PILOT, &in->pilot);
+        read_port(P_PILOT, &in->pilot); /* its time, valid or not: the C2 link's last sign */
         in->cmd_ok = read_port(P_CMD, &in->cmd);
         in->traffic_ok = read_port(P_TRAFFIC, &in->traffic);
         in->radalt_ok = read_port(P_RADALT, &in->radalt);
@@ -119,17 +120,7 @@ int main(void)
     RETURN_CODE_TYPE rc;
     for (int p = 0; p < P_COUNT; p++) {
         const rpas_port_spec_t *ps = &mission_manager_port_spec[p];
-        if (ps->kind == RPAS_PORT_QUEUING) {
-            QUEUING_PORT_ID_TYPE id;
-            CREATE_QUEUING_PORT((char *)ps->name, ps->size, ps->max_nb_messages, ps->direction,
-                                FIFO, &id, &rc);
-            app.id[p] = id;
-        } else {
-            SAMPLING_PORT_ID_TYPE id;
-            CREATE_SAMPLING_PORT((char *)ps->name, ps->size, ps->direction, ps->refresh_ns, &id,
-                                 &rc);
-            app.id[p] = id;
-        }
+        rpas_create_port(ps, &app.id[p], &rc);
         if (rc != NO_ERROR) {
             fail(ps->name, rc);
             return 1;

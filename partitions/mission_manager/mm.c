@@ -126,9 +126,9 @@ static int check_leg(const rpas_plan_leg_t *r, int i, char *err, size_t errlen)
         return bad(err, errlen, "no altitude: leg", i);
     if (r->type == RPAS_LEG_ORBIT && !(r->a > 50.0f))
         return bad(err, errlen, "orbit radius under 50 m: leg", i);
-    if (r->type == RPAS_LEG_SCAN && !(r->a > 100.0f && r->b > 10.0f && r->count >= 1))
+    if (r->type == RPAS_LEG_SCAN && !(r->a > 0.0f && r->b > 0.0f && r->count >= 1))
         return bad(err, errlen, "scan without a length, a spacing or passes: leg", i);
-    if (r->type == RPAS_LEG_AUTOLAND && !(r->c > 100.0f && r->b >= 0.0f && r->b < r->c))
+    if (r->type == RPAS_LEG_AUTOLAND && !(r->c >= 100.0f && r->b >= 0.0f && r->b < r->c))
         return bad(err, errlen, "runway length or aim point: leg", i);
     if (r->type == RPAS_LEG_RF && r->lat2_e7 == r->lat_e7 && r->lon2_e7 == r->lon_e7)
         return bad(err, errlen, "arc centre on the fix: leg", i);
@@ -150,7 +150,7 @@ int mm_plan_load(mm_plan_t *plan, const void *image, size_t len, uint32_t crc, c
         return bad(err, errlen, "leg count and size disagree", -1);
     if (h->n_mission_legs < 1 || h->n_mission_legs > h->n_legs)
         return bad(err, errlen, "mission leg count", -1);
-    if (!(h->min_ias_kt > 0.0f && h->max_ias_kt >= h->min_ias_kt && h->max_bank_deg > 5.0f &&
+    if (!(h->min_ias_kt > 0.0f && h->max_ias_kt >= h->min_ias_kt && h->max_bank_deg >= 5.0f &&
           h->max_vs_fpm > 0.0f && finite_f(h->cruise_ias_kt) && finite_f(h->cruise_alt_ft)))
         return bad(err, errlen, "envelope", -1);
     for (int c = 0; c < RPAS_CT_COUNT; c++) {
@@ -208,7 +208,6 @@ void mm_init(mm_t *mm, const mm_params_t *prm)
     mm->ct_active = NONE_CT;
     mm->ls.leg = -1;
     mm->ls.flyby_crs = NAN;
-    mm->ct_clear_since = -1;
     for (int c = 0; c < RPAS_CT_COUNT; c++)
         mm->cond_since[c] = -1;
 }
@@ -307,7 +306,7 @@ static void pilot_command(mm_t *mm, const rpas_mm_cmd_msg_t *c, const mm_state_t
         return;
     switch (c->cmd) {
     case RPAS_MMC_ENGAGE:
-        mm->state = RPAS_MM_STANDBY;
+        mm->state = mm->engaged ? RPAS_MM_ACTIVE : RPAS_MM_STANDBY;
         mm->ct_active = NONE_CT;
         sequence_from(mm, 0, mm->plan.hdr.n_mission_legs, st, false);
         EVENT("engaged: from the first leg");
@@ -329,6 +328,7 @@ static void pilot_command(mm_t *mm, const rpas_mm_cmd_msg_t *c, const mm_state_t
         break;
     case RPAS_MMC_DIRECT_TO:
         if (c->leg < mm->plan.hdr.n_mission_legs && has_fix(mm->plan.leg[c->leg].raw.type) &&
+            mm->plan.leg[c->leg].raw.type != RPAS_LEG_AUTOLAND &&
             mm->state != RPAS_MM_CONTINGENCY) {
             mm->state = mm->engaged ? RPAS_MM_ACTIVE : RPAS_MM_STANDBY;
             direct_to(mm, (int)c->leg, st); /* then the leg after it */
@@ -408,16 +408,15 @@ static void preempt(mm_t *mm, uint32_t c, const mm_state_t *st, const mm_inputs_
         mm->resume_leg = mm->state == RPAS_MM_PAUSED ? mm->resume_leg : mm->ls.leg;
     mm->ct_active = c;
     mm->ct_t0_ns = st->t_ns;
-    mm->ct_clear_since = -1;
     mm->proc_started = false;
     mm->state = ct->action == RPAS_CTA_TERMINATE ? RPAS_MM_TERMINATED : RPAS_MM_CONTINGENCY;
     if (ct->action == RPAS_CTA_AVOID) {
         /* turn away from the intruder's side, climb or descend away from its altitude */
         mm_vec_t rel_p = {in->traffic.dn_m, in->traffic.de_m};
         double rel = nf_wrap180(mm_course((mm_vec_t){0.0, 0.0}, rel_p) - st->trk_deg);
-        mm->avoid_sign = rel >= 0.0 ? -1.0 : 1.0;
+        double away = rel >= 0.0 ? -1.0 : 1.0; /* it is on the right: turn left */
         double dalt = in->traffic.dalt_ft <= 0.0 ? ct->p2 : -ct->p2;
-        start_synth(mm, RPAS_LEG_VA, st->pos, st->trk_deg + mm->avoid_sign * ct->p1,
+        start_synth(mm, RPAS_LEG_VA, st->pos, st->trk_deg + away * ct->p1,
                     st->alt_ft + dalt, st);
         mm->proc_started = true;
     }
@@ -439,10 +438,10 @@ static void contingency_step(mm_t *mm, const mm_state_t *st)
                   mm_ct_name(mm->ct_active), mm->resume_leg);
             return;
         }
-        mm->proc_leg = ct->first_leg;
+
         EVENT("contingency %s: procedure starts (mission leg %d left)", mm_ct_name(mm->ct_active),
               mm->resume_leg);
-        sequence_from(mm, mm->proc_leg, ct->first_leg + ct->n_legs, st, false);
+        sequence_from(mm, ct->first_leg, ct->first_leg + ct->n_legs, st, false);
     }
 }
 
@@ -451,6 +450,10 @@ static void contingency_step(mm_t *mm, const mm_state_t *st)
  * (holds, orbits, scans and landings join their own path). */
 static void rejoin(mm_t *mm, int i, const mm_state_t *st)
 {
+    if (i < 0) { /* preempted before any leg: from the first */
+        sequence_from(mm, 0, mm->plan.hdr.n_mission_legs, st, false);
+        return;
+    }
     const mm_leg_t *L = &mm->plan.leg[i];
     int t = L->raw.type;
     if (t == RPAS_LEG_TF || t == RPAS_LEG_DF || t == RPAS_LEG_CF || t == RPAS_LEG_RF) {
@@ -487,8 +490,10 @@ static void next_leg(mm_t *mm, const mm_state_t *st)
         const rpas_plan_contingency_t *ct = &mm->plan.hdr.contingency[mm->ct_active];
         if (mm->proc_started) {
             end = ct->first_leg + ct->n_legs;
-            if (mm->ls.leg + 1 >= end)
-                return; /* the procedure's last leg: it stays on it */
+            if (mm->ls.leg + 1 >= end) { /* the procedure's last leg: orbit where it ended */
+                start_synth(mm, RPAS_LEG_ORBIT, st->pos, 0.0, mm->alt_ref_ft, st);
+                return;
+            }
         }
     }
     /* after a direct-to, a fly-by onto the next leg too */
@@ -508,7 +513,6 @@ static bool state_from_nav(const mm_t *mm, const mm_inputs_t *in, int64_t now, m
     st->ias_kt = isfinite(n->ias_kt) ? n->ias_kt : 0.0;
     st->gs_mps = n->gs_kt * NF_KT_MPS;
     st->trk_deg = n->trk_deg;
-    st->hdg_deg = n->hdg_deg;
     st->vs_fpm = n->vs_fpm;
     st->tas_mps = nf_tas_from_ias(st->ias_kt, st->alt_ft) * NF_KT_MPS;
     st->wind_mps = hypot(n->wind_n_kt, n->wind_e_kt) * NF_KT_MPS;
@@ -525,12 +529,13 @@ static void receive_plan(mm_t *mm, const mm_inputs_t *in)
     char err[80];
     if (mm->plan.loaded && in->plan_crc == mm->plan.crc)
         return; /* the plan flown, sent again */
-    if (mm_plan_load(&mm->pending, in->plan, in->plan_len, in->plan_crc, err, sizeof err)) {
+    mm_plan_t candidate; /* a refused plan leaves the one waiting for agreement */
+    if (mm_plan_load(&candidate, in->plan, in->plan_len, in->plan_crc, err, sizeof err)) {
         mm->rejected++;
-        mm->have_pending = false;
         EVENT("plan refused: %s", err);
         return;
     }
+    mm->pending = candidate;
     mm->have_pending = true;
     EVENT("plan %u received (crc 0x%08x): waiting for the replicas",
              (unsigned)mm->pending.hdr.plan_id, (unsigned)mm->pending.crc);
@@ -563,7 +568,10 @@ bool mm_step(mm_t *mm, const mm_inputs_t *in, int64_t now_ns, rpas_mission_msg_t
             if (mm->state == RPAS_MM_STANDBY)
                 mm->state = RPAS_MM_ACTIVE;
         }
-        if (mm->state != RPAS_MM_TERMINATED) {
+        /* once landed (an AUTOLAND ended the mission) nothing preempts the stop */
+        bool landed = mm->state == RPAS_MM_COMPLETE && !mm->flying_synth &&
+                      leg_of(mm)->raw.type == RPAS_LEG_AUTOLAND;
+        if (mm->state != RPAS_MM_TERMINATED && !landed) {
             detect(mm, conditions(mm, in, &st, now_ns), now_ns, in->pilot.t_ns);
             uint32_t best = NONE_CT;
             for (uint32_t c = 0; c < RPAS_CT_COUNT; c++)
@@ -585,7 +593,7 @@ bool mm_step(mm_t *mm, const mm_inputs_t *in, int64_t now_ns, rpas_mission_msg_t
             d = (mm_demand_t){.crs_deg = st.trk_deg, .alt_ft = st.alt_ft - 1000.0,
                               .ias_kt = mm->plan.hdr.min_ias_kt};
         } else {
-            mm_leg_step(&mm->ls, leg_of(mm), &mm->plan.hdr, &mm->prm, &st, &d);
+            mm_leg_step(&mm->ls, leg_of(mm), &mm->prm, &st, &d);
             if (mm->ls.note && !mm->event[0])
                 EVENT("leg %d %s", mm->ls.leg, mm->ls.note);
             bool sequencing = mm->state == RPAS_MM_ACTIVE || mm->state == RPAS_MM_CONTINGENCY;

@@ -20,7 +20,7 @@
     X(chi_inf_deg, 60.0, "largest angle at which a path is approached (far from it)")          \
     X(xte_scale_m, 250.0, "cross-track error at which the approach angle is half chi_inf")     \
     X(arc_lead_s, 2.5, "course lead on arcs: the turn rate times this")                        \
-    X(turn_bank_deg, 20.0, "bank of the planned turns (fly-by anticipation, holds, Dubins)")   \
+    X(turn_bank_deg, 20.0, "bank of the fly-by turns, Dubins paths and made-up orbits")       \
     X(wind_hdg_ratio, 0.8, "wind over true airspeed above which the track is not commanded")  \
     X(alt_kp, 10.0, "vertical speed per foot of altitude error (ft/min per ft)")              \
     X(alt_band_ft, 50.0, "altitude reached: within this")                                     \
@@ -29,7 +29,7 @@
     X(c2_max_age_s, 0.25, "the pilot's last frame older than this: the C2 link is lost")    \
     X(cmd_max_age_s, 1.0, "io's plan-agreement message older than this is not used")         \
     X(traffic_max_age_s, 2.0, "a traffic report older than this is not used")                 \
-    X(hold_default_leg_s, 60.0, "leg time of a hold made up in flight (pause, HOLD action)")  \
+    X(hold_default_leg_s, 60.0, "leg time of a plan's hold that gives none")                  \
     X(hold_rate_dps, 3.0, "turn rate of holds (standard rate), unless max_bank_deg is less")  \
     X(gear_ft, 4.4, "height of the altitude reference above the main wheels on the ground")   \
     X(radalt_max_age_s, 0.3, "a radar altitude older than this is not used")                  \
@@ -114,10 +114,10 @@ bool mm_dubins(mm_vec_t p0, double crs0, mm_vec_t p1, double crs1, double r, mm_
 /* ---- inputs and outputs ------------------------------------------------------------------ */
 
 typedef struct {
-    bool nav_ok, fcs_ok, pilot_ok, cmd_ok, traffic_ok, radalt_ok;
+    bool nav_ok, fcs_ok, cmd_ok, traffic_ok, radalt_ok;
     rpas_nav_msg_t nav;
     rpas_fcs_status_msg_t fcs;
-    rpas_pilot_msg_t pilot;
+    rpas_pilot_msg_t pilot; /* the last one, valid or not: its time is the link's last sign */
     rpas_mm_cmd_msg_t cmd;
     rpas_traffic_msg_t traffic;
     rpas_radalt_msg_t radalt;
@@ -180,7 +180,7 @@ int mm_plan_load(mm_plan_t *plan, const void *image, size_t len, uint32_t crc, c
 /* What the guidance needs of the present state. */
 typedef struct {
     mm_vec_t pos;
-    double alt_ft, ias_kt, gs_mps, trk_deg, hdg_deg, vs_fpm;
+    double alt_ft, ias_kt, gs_mps, trk_deg, vs_fpm;
     double tas_mps, wind_mps;
     double wheels_agl_ft; /* the radar altimeter's height (NaN: none: from the altitude) */
     int64_t t_ns;
@@ -203,8 +203,8 @@ typedef struct {
 void mm_leg_start(mm_leg_state_t *ls, const mm_leg_t *L, const rpas_plan_header_t *hdr,
                   const mm_params_t *prm, const mm_state_t *st, double alt_ref_ft);
 /* One cycle of leg L: its demand; ls->done once the leg's terminator is met. */
-void mm_leg_step(mm_leg_state_t *ls, const mm_leg_t *L, const rpas_plan_header_t *hdr,
-                 const mm_params_t *prm, const mm_state_t *st, mm_demand_t *d);
+void mm_leg_step(mm_leg_state_t *ls, const mm_leg_t *L, const mm_params_t *prm,
+                 const mm_state_t *st, mm_demand_t *d);
 
 /* ---- the guidance layer (mm_guidance.c) --------------------------------------------------- */
 
@@ -228,7 +228,6 @@ typedef struct {
     int64_t cond_since[RPAS_CT_COUNT]; /* when each condition began to hold (-1: not) */
     int64_t ct_t0_ns;   /* when the contingency in force was declared */
     int resume_leg;     /* the mission leg to resume at */
-    int proc_leg;       /* the next procedure leg (contingency) */
     bool proc_started;
     bool engaged;       /* the flight control has flown MISSION since the plan was activated */
     uint32_t last_cmd_seq;
@@ -236,8 +235,6 @@ typedef struct {
     mm_leg_state_t ls;
     mm_leg_t synth;     /* a leg made up in flight (direct-to, hold here, avoid), when ls flies it */
     bool flying_synth;
-    int64_t ct_clear_since; /* when the contingency in force stopped holding (-1: holds) */
-    double avoid_sign;  /* AVOID: -1 left, +1 right */
     double alt_ref_ft;
     mm_demand_t last;
     char event[96];     /* the last state change, for the partition's report ("" none) */

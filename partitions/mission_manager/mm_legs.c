@@ -28,6 +28,9 @@ enum hold_phase {
 
 enum land_phase { L_FINAL = 0, L_FLARE, L_ROLLOUT, L_STOPPED };
 
+/* DUBINS: the first arc, the straight, the last arc; or, too close for a Dubins path, direct */
+enum dubins_phase { D_ARC1 = 0, D_LINE, D_ARC2, D_DIRECT };
+
 static double turn_r(const mm_params_t *prm, const mm_state_t *st)
 {
     return mm_turn_radius(fmax(st->gs_mps, st->tas_mps), prm->turn_bank_deg);
@@ -151,7 +154,7 @@ void mm_leg_start(mm_leg_state_t *ls, const mm_leg_t *L, const rpas_plan_header_
         double rad = r->a > 0.0f ? r->a : turn_r(prm, st);
         if (!mm_dubins(st->pos, st->trk_deg, L->fix, r->course_deg, rad, &ls->dubins)) {
             ls->seg = mm_line(st->pos, L->fix); /* too close for a Dubins path: direct */
-            ls->phase = 3;
+            ls->phase = D_DIRECT;
             break;
         }
         ls->seg = ls->dubins.arc1;
@@ -286,14 +289,14 @@ static void dubins_step(mm_leg_state_t *ls, const mm_leg_t *L, const mm_state_t 
                         const mm_track_t *tk)
 {
     const mm_dubins_t *d = &ls->dubins;
-    if (ls->phase == 0) {
+    if (ls->phase == D_ARC1) {
         double rem = arc_remaining(d->arc1.c, st->pos, mm_course(d->arc1.c, d->t1), d->arc1.dir);
         if (rem < 3.0 || rem > ls->arc_rem0 + 20.0)
-            phase(ls, 1, d->line, st);
-    } else if (ls->phase == 1) {
+            phase(ls, D_LINE, d->line, st);
+    } else if (ls->phase == D_LINE) {
         if (tk->to_go_m <= 0.0)
-            phase(ls, 2, d->arc2, st);
-    } else if (ls->phase == 2) {
+            phase(ls, D_ARC2, d->arc2, st);
+    } else if (ls->phase == D_ARC2) {
         double rem = arc_remaining(d->arc2.c, st->pos, mm_course(d->arc2.c, L->fix), d->arc2.dir);
         if (rem < 2.0 || rem > 300.0)
             ls->done = true;
@@ -369,11 +372,10 @@ static void land_step(mm_leg_state_t *ls, const mm_leg_t *L, const mm_params_t *
     }
 }
 
-void mm_leg_step(mm_leg_state_t *ls, const mm_leg_t *L, const rpas_plan_header_t *hdr,
-                 const mm_params_t *prm, const mm_state_t *st, mm_demand_t *d)
+void mm_leg_step(mm_leg_state_t *ls, const mm_leg_t *L, const mm_params_t *prm,
+                 const mm_state_t *st, mm_demand_t *d)
 {
     const rpas_plan_leg_t *r = &L->raw;
-    (void)hdr;
     ls->note = NULL;
     if (ls->turning_in) {
         /* the fly-by arc ends where its course is the leg's (the tangent point) */

@@ -46,6 +46,20 @@ def construct(root: yaml.Node | None):
         loader.dispose()
 
 
+def load_document(text: str, path, error: type[Exception]):
+    """`load(text)`; a document beyond the bounds or not YAML raises `error` with one line
+    naming `path` (and, for YAML, the line and column)."""
+    try:
+        return load(text)
+    except YamlLimitError as e:
+        raise error(f"{path}: refused: {e}") from e
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""
+        raise error(f"{path}: not valid YAML{where}: "
+                    f"{getattr(e, 'problem', None) or e}") from e
+
+
 def load(text: str):
     """safe_load, within the bounds."""
     return construct(compose(text))

@@ -50,8 +50,6 @@ CLASSES = {
                           "uplink sent, no downlink heard"),
     "ap_disengage": FaultClass("station", "pilot_mode", (), "the station commands DIRECT over "
                                "the uplink (an autopilot disengagement)"),
-    "uplink_corrupt": FaultClass("station", "mission_uplink", (), "every mission plan segment "
-                                 "the station sends has one bit flipped (the plan's CRC fails)"),
     "actuator_jam": FaultClass("actuators", None, ("surface",), "the actuator stays where it "
                                "was at the spell's start"),
     "actuator_hardover": FaultClass("actuators", None, ("surface", "value"), "the actuator runs "
@@ -155,7 +153,6 @@ class WorldFaults:
         # station effects, read by the world
         self.c2_down = False
         self.disengage = False
-        self.uplink_corrupt = False
         self.pitot_pt: float | None = None
 
     def next_t(self) -> int:
@@ -229,7 +226,7 @@ class WorldFaults:
         gps_off = None
         ahrs_ops: list = []
         pitot = None
-        c2_down = disengage = corrupt = False
+        c2_down = disengage = False
         override: list = [None] * 4
         for f in sorted((f for f in self.faults if f.spell >= 0), key=lambda f: f.order):
             cls, d = f.spec.cls, f.detail
@@ -250,8 +247,6 @@ class WorldFaults:
                 c2_down = True
             elif cls == "ap_disengage":
                 disengage = True
-            elif cls == "uplink_corrupt":
-                corrupt = True
             else:
                 i = SURFACES.index(f.target)
                 if cls == "actuator_jam":
@@ -266,7 +261,6 @@ class WorldFaults:
         self.pitot_pt = pitot
         self.c2_down = c2_down
         self.disengage = disengage
-        self.uplink_corrupt = corrupt
         w.act.override = override if any(o is not None for o in override) else None
 
     def summary(self) -> list[dict]:

@@ -8,7 +8,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import jsonschema
-import yaml
 
 from ima import yamlfile
 from ima.errors import ImaError
@@ -94,6 +93,9 @@ SCHEMA = {
                         },
                     },
                     "c2_link": {"enum": ["up", "down"]},
+                    # the station's uplink of mission plans: `corrupt` flips a bit of every
+                    # segment it sends (a plan's CRC then fails), until `ok`
+                    "uplink": {"enum": ["ok", "corrupt"]},
                     # a mission command the station uplinks (the mission manager acts on it)
                     "mission": {"oneOf": [
                         {"enum": ["engage", "pause", "resume"]},
@@ -159,7 +161,7 @@ class PilotScript:
             "heading_deg": s["heading_deg"], "altitude_ft": s["altitude_ft"],
             "airspeed_kt": s["airspeed_kt"], "vs_fpm": 0.0,
             "stick": {"pitch": 0.0, "roll": 0.0, "yaw": 0.0, "throttle": None},
-            "c2_link": "up", "gps": "ok", "wind": None,
+            "c2_link": "up", "gps": "ok", "uplink": "ok", "wind": None,
         }
 
     @staticmethod
@@ -268,13 +270,4 @@ def load(path: str | Path) -> PilotScript:
     except UnicodeDecodeError as e:
         raise PilotScriptError(f"{path}: not a text file in UTF-8 (byte {e.start}: "
                                f"{e.reason})") from e
-    try:
-        doc = yamlfile.load(text)
-    except yamlfile.YamlLimitError as e:
-        raise PilotScriptError(f"{path}: refused: {e}") from e
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""
-        raise PilotScriptError(f"{path}: not valid YAML{where}: "
-                               f"{getattr(e, 'problem', None) or e}") from e
-    return parse(doc, str(path))
+    return parse(yamlfile.load_document(text, path, PilotScriptError), str(path))

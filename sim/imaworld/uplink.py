@@ -18,7 +18,7 @@ from ima.canbus.codec import MESSAGES
 _UPLOAD = MESSAGES["MISSION_UPLOAD"]
 _CMD = MESSAGES["MISSION_CMD"]
 SEG_BYTES = 6
-MAX_IMAGE = 0xFFFF
+MAX_IMAGE = 2504  # RPAS_PLAN_MAX_BYTES (partitions/include/rpas/mission_plan.h): io's bound
 COMMANDS = {"engage": 1, "pause": 2, "resume": 3, "direct_to": 4}
 
 
@@ -43,8 +43,8 @@ def segments(image: bytes, cnt: int) -> list[bytes]:
 class Uplink:
     """What the station sends of the mission: uploads queued at their times, and commands.
 
-    `uploads`: [(t_ns, image)] in time order. `corrupt(t_ns, k)`: whether segment k of the
-    upload in progress goes out with a bit flipped (the station's uplink_corrupt fault)."""
+    `uploads`: [(t_ns, image)] in time order. `due`'s `corrupt(t_ns)`: whether the segments
+    sent at t_ns go out with a bit flipped (the station's uplink_corrupt fault)."""
 
     def __init__(self, uploads: list[tuple[int, bytes]], params: UplinkParams = UplinkParams()):
         self.p = params

@@ -353,8 +353,7 @@ class World:
 
     def _uplink_plan(self, t: int) -> None:
         up = self.uplink
-        corrupt = (lambda _t: self.faults.uplink_corrupt) if self.faults else (lambda _t: False)
-        frames = up.due(t, self.link_up(), corrupt)
+        frames = up.due(t, self.link_up(), lambda _t: self.station["uplink"] == "corrupt")
         if frames:
             self._send(t, frames)
         for te, kind, f in up.events[self._uplink_ev_done:]:

@@ -34,9 +34,9 @@ FLIGHTS = {
                       "--fault", "world:ahrs_stuck@410:counter=frozen", "--no-judge"],
     # the second plan's upload is corrupted (kept out), the third's goes through
     "replan": ["--mission", MISSIONS / "tf_square.yaml", "--duration", "150",
+               "--pilot", DATA / "corrupt_uplink_pilot.yaml",
                "--replan", f"40:{DATA / 'contingencies.yaml'}",
-               "--replan", f"100:{DATA / 'contingencies.yaml'}",
-               "--fault", "world:uplink_corrupt@39~20", "--no-judge"],
+               "--replan", f"100:{DATA / 'contingencies.yaml'}"],
     "repeat1": ["--mission", MISSIONS / "tf_square.yaml", "--duration", "90", "--seed", "7"],
     "repeat2": ["--mission", MISSIONS / "tf_square.yaml", "--duration", "90", "--seed", "7"],
 }

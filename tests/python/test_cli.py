@@ -18,7 +18,7 @@ from ima.errors import ImaError
 @pytest.mark.parametrize(
     ("argv", "func", "expected"),
     [
-        (["demo"], demo.run, {"duration": 600.0, "seed": 1, "turbulence": "light", "wind": 10.0}),
+        (["demo"], demo.run, {"duration": 1750.0, "seed": 1, "turbulence": "light", "wind": 10.0}),
         (["demo", "--duration", "60", "--seed", "3"], demo.run, {"duration": 60.0, "seed": 3}),
         (
             ["fly", "--duration", "600", "--seed", "7", "--json"],

@@ -90,10 +90,10 @@ enum rpas_contingency {
 enum rpas_ct_action {
     RPAS_CTA_NONE = 0,      /* not declared: ignored */
     RPAS_CTA_PROCEDURE = 1, /* continue `continue_s`, then fly the procedure's legs */
-    RPAS_CTA_AVOID = 2,     /* traffic: turn away by `offset_deg` and climb or descend
-                               `alt_offset_ft` away from the intruder until clear */
+    RPAS_CTA_AVOID = 2,     /* traffic: turn away by p1 (the plan's offset_deg) and climb or
+                               descend p2 (altitude_offset_ft) away from the intruder until clear */
     RPAS_CTA_HOLD = 3,      /* hold where it is (an orbit about the present position) */
-    RPAS_CTA_TERMINATE = 4  /* flight termination: engine cut, the termination system fired */
+    RPAS_CTA_TERMINATE = 4  /* flight termination: the engine cut (nav_fcs), state latched */
 };
 
 /* One contingency: 24 bytes. */
@@ -118,7 +118,7 @@ typedef struct {
     int32_t origin_lat_e7, origin_lon_e7; /* the local frame's origin */
     float cruise_ias_kt, cruise_alt_ft;
     float min_ias_kt, max_ias_kt; /* envelope: no airspeed target outside */
-    float max_bank_deg;           /* turn radius of fly-by turns and arcs */
+    float max_bank_deg;           /* the steepest bank: holds, and the planned arcs' radii */
     float max_vs_fpm;             /* climb and descent rates */
     float traffic_h_m, traffic_v_ft; /* loss of separation with an intruder: closer than both */
     float pad[6];

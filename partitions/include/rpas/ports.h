@@ -114,14 +114,14 @@ typedef struct {
     double wind_n_kt, wind_e_kt; /* wind estimate: where the air moves to */
 } rpas_nav_msg_t;
 
-/* The mission manager's state (rpas_mm_status_msg_t.state, MISSION_STATUS_x.MM_STATE). */
+/* The mission manager's state (rpas_mm_status_msg_t.state, MISSION_STATUS_x.MS_STATE_x). */
 enum rpas_mm_state {
     RPAS_MM_NO_PLAN = 0,     /* no plan yet: no targets */
     RPAS_MM_STANDBY = 1,     /* a plan, the flight control not in MISSION yet: targets, no sequencing */
     RPAS_MM_ACTIVE = 2,      /* flying the plan's legs */
     RPAS_MM_PAUSED = 3,      /* the pilot paused: holding where it was */
     RPAS_MM_CONTINGENCY = 4, /* a contingency's procedure preempts the plan */
-    RPAS_MM_COMPLETE = 5,    /* the last leg is done: orbiting its end (or stopped, after a landing) */
+    RPAS_MM_COMPLETE = 5,    /* the last leg is done: orbiting where it ended (or stopped, landed) */
     RPAS_MM_TERMINATED = 6,  /* flight termination: the defined safe state */
 };
 
@@ -163,7 +163,7 @@ typedef struct {
     double pad;
 } rpas_traffic_msg_t;
 
-/* mission manager -> io (downlink) and the recorder: port MM_STATUS_OUT */
+/* mission manager -> io (downlink MISSION_STATUS_x): port MM_STATUS_OUT */
 typedef struct {
     int64_t t_ns;
     uint32_t state;       /* enum rpas_mm_state */

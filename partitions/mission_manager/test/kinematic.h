@@ -67,8 +67,7 @@ static inline void inputs(const ac_t *a, world_t *w, mm_inputs_t *in)
     in->fcs.mode = w->fcs_mode ? w->fcs_mode : (w->fcs_mission ? RPAS_MODE_MISSION : RPAS_MODE_AUTOPILOT);
     if (w->c2_up)
         w->pilot_t = a->t;
-    in->pilot_ok = w->c2_up; /* the port keeps the last message when it goes invalid */
-    in->pilot.t_ns = w->pilot_t;
+    in->pilot.t_ns = w->pilot_t; /* the port keeps the last message when it goes invalid */
     in->cmd_ok = true;
     in->cmd = (rpas_mm_cmd_msg_t){.t_ns = a->t, .plan_crc = w->agreed_crc, .cmd_seq = w->cmd_seq,
                                   .cmd = w->cmd, .leg = w->cmd_leg};

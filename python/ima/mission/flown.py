@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ima.mission.geometry import FT, LegPath, leg_paths
+from ima.mission.geometry import FT, Frame, LegPath, leg_paths
 from ima.mission.plan import Plan
 
 CAPTURE_M = 15.0
@@ -34,6 +34,7 @@ CAPTURE_DEG = 10.0
 _RACETRACK = re.compile(r"mission_manager: leg (\d+) hold: (\w+) entry flown")
 PASS_TRACK_DEG = 30.0
 AUTOLAND_JUDGED_ABOVE_FT = 50.0
+NEXT_LEG_NS = 60 * 10**9  # a fix is passed within the next leg's first minute (fly-by)
 CAPTURE_ALT_M = 15.0
 _STATE = re.compile(r"mission_manager: ([A-Z_]+) leg (-?\d+) (\S+)$")
 _DECLARED = re.compile(r"mission_manager: contingency (\w+) declared at leg (-?\d+)$")
@@ -93,8 +94,7 @@ def contingencies(msgs: list[tuple[int, str]]) -> list[dict]:
     for t, text in msgs:
         if m := _DECLARED.match(text):
             out.append({"event": m.group(1), "t_s": t / 1e9, "leg": int(m.group(2)),
-                        "procedure": None, "procedure_t_s": None, "resumed_t_s": None,
-                        "resumed_leg": None})
+                        "procedure_t_s": None, "resumed_t_s": None, "resumed_leg": None})
         elif (m := _STARTS.match(text)) and out and out[-1]["event"] == m.group(1):
             out[-1]["procedure_t_s"] = t / 1e9
         elif (m := _CLEARED.match(text)) and out and out[-1]["event"] == m.group(1):
@@ -306,8 +306,6 @@ def judge(run_dir: Path, plan: Plan, node: str) -> dict:
     msgs = reports(run_dir / f"{node}.jsonl")
     ivs = intervals(msgs, end)
     paths = leg_paths(plan)
-    from ima.mission.geometry import Frame
-
     frame = Frame(plan.origin_lat_deg, plan.origin_lon_deg)
     ne_all = frame.to_local(truth["lat_deg"], truth["lon_deg"]) if len(t) else np.zeros((0, 2))
     legs = []
@@ -345,7 +343,7 @@ def judge(run_dir: Path, plan: Plan, node: str) -> dict:
         k = np.flatnonzero(whole)
         ext = whole.copy()
         if len(k):
-            ext[k[-1]:min(k[-1] + 600, len(t))] = True
+            ext[k[-1]:] = t[k[-1]:] <= t[k[-1]] + NEXT_LEG_NS
         fix_ne = (frame.to_local(plan.waypoints[leg.fix].lat_deg, plan.waypoints[leg.fix].lon_deg)
                   if leg.fix in plan.waypoints else None)
         stats.update(terminator(path, leg, ne_all[ext if fix_ne is not None else whole],

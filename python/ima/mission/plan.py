@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import jsonschema
-import yaml
 
 from ima import paths, yamlfile
 from ima.errors import ImaError
@@ -409,13 +408,4 @@ def load(path: str | Path) -> Plan:
     except UnicodeDecodeError as e:
         raise MissionPlanError(f"{path}: not a text file in UTF-8 (byte {e.start}: "
                                f"{e.reason})") from e
-    try:
-        doc = yamlfile.load(text)
-    except yamlfile.YamlLimitError as e:
-        raise MissionPlanError(f"{path}: refused: {e}") from e
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""
-        raise MissionPlanError(f"{path}: not valid YAML{where}: "
-                               f"{getattr(e, 'problem', None) or e}") from e
-    return parse(doc, str(path))
+    return parse(yamlfile.load_document(text, path, MissionPlanError), str(path))

@@ -185,6 +185,7 @@ def test_c2_loss_runs_its_procedure_and_the_mission_resumes(flights):
     assert c["procedure_t_s"] == pytest.approx(c["t_s"] + 10, abs=FRAME_S), c
     assert 100 <= c["resumed_t_s"] <= 100 + 2 * FRAME_S, c
     assert c["resumed_leg"] == c["leg"], c  # at the leg it left
+    assert c["procedure"] == "DF RALLY, HM RALLY", c
     reports = [text for t, text in _reports(s) if c["procedure_t_s"] <= t < c["resumed_t_s"]]
     assert any("CONTINGENCY leg 9 DF" in r for r in reports), reports  # the procedure's DF
 

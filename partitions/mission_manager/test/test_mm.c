@@ -477,6 +477,14 @@ static void test_pilot_commands(void)
         fly(&mm, &a, &w, NULL, 0.05, &st);
     CHECK(st.state == RPAS_MM_COMPLETE); /* leg 3 was the last: direct to its fix, then done */
     CHECK(hypot(a.n + 4000.0, a.e) < 2000.0);
+    /* engage: the plan again from its first leg, sequenced (the flight control flies it) */
+    w.cmd_seq = 4, w.cmd = RPAS_MMC_ENGAGE;
+    fly(&mm, &a, &w, NULL, 0.1, &st);
+    CHECK(st.state == RPAS_MM_ACTIVE && st.leg == 1);
+    k = 0;
+    while (st.leg == 1 && k++ < 20 * 400)
+        fly(&mm, &a, &w, NULL, 0.05, &st);
+    CHECK(st.leg == 2 && st.state == RPAS_MM_ACTIVE);
 }
 
 /* An approach without an airspeed of its own, entered by a fly-by turn: every target nav_fcs

@@ -122,13 +122,13 @@ def print_mission(s: dict, console) -> None:
     if conts:
         console.print("Contingencies:")
         t = Table(show_edge=False)
-        for col in ("event", "declared", "procedure", "resumed", "resumed at leg"):
-            t.add_column(col, justify="left" if col == "event" else "right")
+        for col in ("event", "declared", "procedure", "began", "resumed", "resumed at leg"):
+            t.add_column(col, justify="left" if col in ("event", "procedure") else "right")
         for c in conts:
             declared = _at(c.get("t_s")) + (f" (leg {c['leg']})" if c.get("leg") is not None
                                             else "")
-            t.add_row(escape(str(c.get("event"))), declared, _at(c.get("procedure_t_s")),
-                      _at(c.get("resumed_t_s")),
+            t.add_row(escape(str(c.get("event"))), declared, escape(str(c.get("procedure") or "-")),
+                      _at(c.get("procedure_t_s")), _at(c.get("resumed_t_s")),
                       "-" if c.get("resumed_leg") is None else str(c["resumed_leg"]))
         console.print(t)
     else:

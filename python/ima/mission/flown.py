@@ -88,12 +88,28 @@ def intervals(msgs: list[tuple[int, str]], end_ns: int) -> list[Interval]:
     return [iv for iv in out if iv.t1_ns > iv.t0_ns]
 
 
-def contingencies(msgs: list[tuple[int, str]]) -> list[dict]:
-    """Each contingency: when it was declared, its procedure's start, the mission's resumption."""
+def procedure_text(plan: Plan | None, event: str) -> str | None:
+    """What the plan does for a contingency: "DF RALLY, HM RALLY", "hold", "avoid 60 deg,
+    500 ft", "terminate" (None: not in the plan)."""
+    c = plan.contingencies.get(event) if plan is not None else None
+    if c is None:
+        return None
+    if c.action == "procedure":
+        return ", ".join(f"{leg.type} {leg.fix or leg.runway or ''}".strip()
+                         for leg in c.procedure)
+    if c.action == "avoid":
+        return f"avoid {c.offset_deg:g} deg, {c.altitude_offset_ft:g} ft"
+    return c.action
+
+
+def contingencies(msgs: list[tuple[int, str]], plan: Plan | None = None) -> list[dict]:
+    """Each contingency: when it was declared, the procedure the plan gives for it and when it
+    began, the mission's resumption."""
     out: list[dict] = []
     for t, text in msgs:
         if m := _DECLARED.match(text):
             out.append({"event": m.group(1), "t_s": t / 1e9, "leg": int(m.group(2)),
+                        "procedure": procedure_text(plan, m.group(1)),
                         "procedure_t_s": None, "resumed_t_s": None, "resumed_leg": None})
         elif (m := _STARTS.match(text)) and out and out[-1]["event"] == m.group(1):
             out[-1]["procedure_t_s"] = t / 1e9
@@ -358,6 +374,6 @@ def judge(run_dir: Path, plan: Plan, node: str) -> dict:
                     "final_state": final.state if final else None,
                     "final_leg": final.leg if final else None},
         "legs": legs,
-        "contingencies": contingencies(msgs),
+        "contingencies": contingencies(msgs, plan),
         "autoland": autoland(run_dir, plan, frame),
     }

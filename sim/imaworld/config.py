@@ -26,6 +26,19 @@ class GpsParams:
     lost_mode: str = "no_fix"
 
 
+# Augmented GPS (the script's `gps_augmentation`): the errors it leaves (bias per horizontal
+# axis, vertical bias, white noise horizontal and vertical, in metres) and the GPS_FIX it
+# reports: SBAS-grade (a few decimetres) and GBAS-grade (approach and flare).
+GPS_AUGMENTATION = {
+    "none": {"bias_sigma_h_m": 2.0, "bias_sigma_v_m": 4.0, "noise_h_m": 1.5, "noise_v_m": 3.0,
+             "fix": 3},
+    "sbas": {"bias_sigma_h_m": 0.5, "bias_sigma_v_m": 1.0, "noise_h_m": 0.4, "noise_v_m": 0.8,
+             "fix": 4},
+    "gbas": {"bias_sigma_h_m": 0.1, "bias_sigma_v_m": 0.2, "noise_h_m": 0.15, "noise_v_m": 0.3,
+             "fix": 5},
+}
+
+
 @dataclass(frozen=True)
 class AhrsParams:
     period_ms: int = 20  # AHRS_ATT, AHRS_RATE, AHRS_ACCEL at 50 Hz

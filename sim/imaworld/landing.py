@@ -7,7 +7,8 @@ first) and a crash beyond them. After it, a main gear off the ground for `bounce
 wheels `bounce_ft` above their touchdown height is a bounce; the first instant the ground speed
 falls under `stopped_kt` is the stop. The brakes are commanded over CAN (BRAKE_CMD_A..C, sent
 only while a flight-control channel brakes): the brake actuator follows the median of the
-channels heard in the last `brake_fresh_s` (none: released) at its rate limit, on both main wheels."""
+channels heard in the last `brake_fresh_s` (none: released) at its rate limit, on both main
+wheels."""
 
 from __future__ import annotations
 

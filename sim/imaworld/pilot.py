@@ -48,6 +48,8 @@ SCHEMA = {
             },
         },
         "turbulence": {"enum": ["none", "light", "moderate"]},
+        # augmented GPS (SBAS- or GBAS-grade): smaller errors, reported in GPS_FIX
+        "gps_augmentation": {"enum": ["none", "sbas", "gbas"]},
         # scripted intruders, reported by the surveillance receiver (traffic.py)
         "traffic": {
             "type": "array",
@@ -147,6 +149,7 @@ class PilotScript:
     description: str = ""
     pilot_model: bool = True
     traffic: list[dict] = field(default_factory=list)
+    gps_augmentation: str = "none"
     initial: dict = field(default_factory=dict)
 
     @property
@@ -258,7 +261,8 @@ def parse(doc, path: str = "<script>") -> PilotScript:
         settle_s=(doc.get("evaluate") or {}).get("settle_s"),
         wind=doc.get("wind"), turbulence=doc.get("turbulence"),
         duration_s=doc.get("duration_s"), description=doc.get("description", ""),
-        pilot_model=doc.get("pilot_model", True), traffic=list(doc.get("traffic") or []))
+        pilot_model=doc.get("pilot_model", True), traffic=list(doc.get("traffic") or []),
+        gps_augmentation=doc.get("gps_augmentation", "none"))
 
 
 def load(path: str | Path) -> PilotScript:

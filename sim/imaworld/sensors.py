@@ -6,12 +6,13 @@ from __future__ import annotations
 import itertools
 import math
 import zlib
+from dataclasses import replace
 
 import numpy as np
 
 from ima.canbus.codec import MESSAGES
 
-from .config import FT_TO_M, AdcParams, AhrsParams, GpsParams, RadaltParams
+from .config import FT_TO_M, GPS_AUGMENTATION, AdcParams, AhrsParams, GpsParams, RadaltParams
 
 R_EARTH_M = 6_378_137.0
 MPS_TO_KT = 1.0 / 0.514444
@@ -58,9 +59,14 @@ class GaussMarkov:
 
 
 class Gps:
-    """GPS receiver: GPS_POS + GPS_VEL at each sample; state ok / lost / frozen."""
+    """GPS receiver: GPS_POS + GPS_VEL at each sample; state ok / lost / frozen; with an
+    augmentation (config.GPS_AUGMENTATION) its errors and the fix it reports."""
 
-    def __init__(self, p: GpsParams, seed: int) -> None:
+    def __init__(self, p: GpsParams, seed: int, augmentation: str = "none") -> None:
+        a = GPS_AUGMENTATION[augmentation]
+        p = replace(p, bias_sigma_h_m=a["bias_sigma_h_m"], bias_sigma_v_m=a["bias_sigma_v_m"],
+                    noise_h_m=a["noise_h_m"], noise_v_m=a["noise_v_m"])
+        self.fix = a["fix"]
         self.p = p
         self.n = rng = normal_stream(seed, "gps")
         dt = p.period_ms / 1000.0
@@ -111,7 +117,7 @@ class Gps:
         if trk >= 359.995:
             trk = 0.0
         out = [(_GPS_POS.frame_id, _GPS_POS.encode(mlat, mlon)),
-               (_GPS_VEL.frame_id, _GPS_VEL.encode(alt_ft + du / FT_TO_M, gs, trk, 3, p.sats,
+               (_GPS_VEL.frame_id, _GPS_VEL.encode(alt_ft + du / FT_TO_M, gs, trk, self.fix, p.sats,
                                                    self.cnt))]
         self.last = out
         return out

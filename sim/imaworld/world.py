@@ -115,7 +115,7 @@ class World:
                              self._selector(opts.channels, opts.voting, params,
                                             "no-vote-out" in opts.test_switches))
         self.ac.set_controls(*self.act.pos)
-        self.gps = Gps(params.gps, seed)
+        self.gps = Gps(params.gps, seed, script.gps_augmentation)
         self.ahrs = Ahrs(params.ahrs, seed)
         self.adc = AirData(params.adc, seed)
         self.radalt = RadarAltimeter(params.radalt, seed)

@@ -44,7 +44,7 @@ for _s in SEEDS:
     for _turb in ("none", "light"):
         FLIGHTS[f"land-{_turb}-{_s}"] = [
             "--mission", DATA / "approach.yaml", "--pilot", DATA / "approach_pilot.yaml",
-            "--duration", "380", "--seed", str(_s), "--turbulence", _turb]
+            "--duration", "430", "--seed", str(_s), "--turbulence", _turb]
 
 
 def _fly(base: Path, name: str) -> tuple[str, dict]:

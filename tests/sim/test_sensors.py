@@ -48,6 +48,21 @@ def test_gps_noise_and_bias():
     assert fix == (3, 3, 3) and cnt == (1, 2, 3)
 
 
+@pytest.mark.parametrize("mode,fix", [("sbas", 4), ("gbas", 5)])
+def test_augmented_gps(mode, fix):
+    """SBAS- and GBAS-grade receivers: their own errors, and GPS_FIX says which."""
+    from imaworld.config import GPS_AUGMENTATION
+
+    pos, vel = MESSAGES["GPS_POS"], MESSAGES["GPS_VEL"]
+    g = Gps(GpsParams(), 1, mode)
+    samples = [g.sample(LAT, LON, 3000.0, 100.0, 150.0) for _ in range(3000)]
+    north = [(pos.decode(f[0][1])[0] - LAT) * M_PER_DEG for f in samples]
+    a = GPS_AUGMENTATION[mode]
+    assert _diff_std(north) == pytest.approx(a["noise_h_m"], rel=0.15)
+    assert statistics.pstdev(north) < 3 * (a["noise_h_m"] + a["bias_sigma_h_m"])
+    assert {vel.decode(f[1][1])[3] for f in samples} == {fix}
+
+
 def test_gauss_markov_statistics():
     gm = GaussMarkov(normal_stream(7, "t"), sigma=2.0, tau_s=10.0, dt_s=0.2)
     xs = [gm.step() for _ in range(200_000)]

@@ -8,6 +8,8 @@ values with its aliases counted where they are used."""
 
 from __future__ import annotations
 
+import math
+
 import yaml
 
 MAX_DEPTH = 64  # the product's own files nest 8 levels at most
@@ -58,6 +60,20 @@ def load_document(text: str, path, error: type[Exception]):
         where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""
         raise error(f"{path}: not valid YAML{where}: "
                     f"{getattr(e, 'problem', None) or e}") from e
+
+
+def first_not_finite(value, where: tuple = ()) -> tuple[tuple, float] | None:
+    """The first NaN or infinity in a loaded document, with the path to it (a JSON Schema's
+    bounds let them through: every comparison with NaN is false); None if there is none."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return where, value
+    items = value.items() if isinstance(value, dict) else enumerate(value) \
+        if isinstance(value, list) else ()
+    for k, v in items:
+        found = first_not_finite(v, where + (k,))
+        if found is not None:
+            return found
+    return None
 
 
 def load(text: str):

@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -221,23 +220,9 @@ class PilotScript:
         return out
 
 
-def _not_finite(value, where: tuple = ()) -> tuple[tuple, float] | None:
-    """The first NaN or infinity in the document (JSON Schema's bounds let them through: every
-    comparison with NaN is false), with where it is."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return where, value
-    items = value.items() if isinstance(value, dict) else enumerate(value) \
-        if isinstance(value, list) else ()
-    for k, v in items:
-        found = _not_finite(v, where + (k,))
-        if found is not None:
-            return found
-    return None
-
-
 def parse(doc, path: str = "<script>") -> PilotScript:
     """Validate a parsed YAML document and build the script; PilotScriptError if it is bad."""
-    bad = _not_finite(doc)
+    bad = yamlfile.first_not_finite(doc)
     if bad is not None:
         where, val = bad
         raise PilotScriptError(f"{path}: {_path(where)}: {val} is not a finite number")

@@ -154,19 +154,6 @@ def path_text(parts) -> str:
     return out or "(top level)"
 
 
-def _not_finite(value, where: tuple = ()) -> tuple[tuple, float] | None:
-    """The first NaN or infinity in the document (every bound of a schema lets them pass)."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return where, value
-    items = value.items() if isinstance(value, dict) else enumerate(value) \
-        if isinstance(value, list) else ()
-    for k, v in items:
-        found = _not_finite(v, where + (k,))
-        if found is not None:
-            return found
-    return None
-
-
 def _schema_message(e: jsonschema.ValidationError) -> str:
     if e.validator == "additionalProperties" and isinstance(e.instance, dict):
         allowed = list(e.schema.get("properties", {}))
@@ -347,7 +334,7 @@ class _Checker:
 
 def parse(doc, path: str = "<plan>") -> Plan:
     """Checks a parsed YAML document and builds the plan; MissionPlanError if it is wrong."""
-    bad = _not_finite(doc)
+    bad = yamlfile.first_not_finite(doc)
     if bad is not None:
         where, value = bad
         raise MissionPlanError(f"{path}: {path_text(where)}: {value} is not a finite number")

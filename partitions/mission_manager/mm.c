@@ -404,8 +404,8 @@ static int rank(uint32_t c)
 static void preempt(mm_t *mm, uint32_t c, const mm_state_t *st, const mm_inputs_t *in)
 {
     const rpas_plan_contingency_t *ct = &mm->plan.hdr.contingency[c];
-    if (mm->ct_active == NONE_CT)
-        mm->resume_leg = mm->state == RPAS_MM_PAUSED ? mm->resume_leg : mm->ls.leg;
+    if (mm->ct_active == NONE_CT && mm->state != RPAS_MM_PAUSED)
+        mm->resume_leg = mm->ls.leg; /* (a contingency preempting another keeps its leg) */
     mm->ct_active = c;
     mm->ct_t0_ns = st->t_ns;
     mm->proc_started = false;
@@ -430,8 +430,8 @@ static void contingency_step(mm_t *mm, const mm_state_t *st)
     bool later = ct->action == RPAS_CTA_PROCEDURE || ct->action == RPAS_CTA_HOLD;
     if (later && !mm->proc_started && age_s(st->t_ns, mm->ct_t0_ns) + 1e-9 >= ct->continue_s) {
         mm->proc_started = true;
-        if (!mm->flying_synth)
-            mm->resume_leg = mm->ls.leg; /* the mission went on meanwhile */
+        if (!mm->flying_synth && mm->ls.leg < mm->plan.hdr.n_mission_legs)
+            mm->resume_leg = mm->ls.leg; /* the mission went on meanwhile (not a procedure's) */
         if (ct->action == RPAS_CTA_HOLD) {
             start_synth(mm, RPAS_LEG_ORBIT, st->pos, 0.0, mm->alt_ref_ft, st);
             EVENT("contingency %s: procedure starts (mission leg %d left)",

@@ -382,6 +382,37 @@ static void test_c2_loss_procedure_and_resume(void)
     CHECK(m.mode == RPAS_MODE_MISSION);
 }
 
+/* A contingency preempting another's procedure: the mission resumes at the mission's leg. */
+static void test_nested_contingencies(void)
+{
+    image_t im;
+    square(&im);
+    add(&im, RPAS_LEG_DF, 3000, 3000); /* the autopilot's procedure */
+    add(&im, RPAS_LEG_DF, -3000, 3000); /* the link's */
+    im.h.contingency[RPAS_CT_AP_DISENGAGE] = (rpas_plan_contingency_t){
+        .action = RPAS_CTA_PROCEDURE, .resume = 1, .first_leg = 4, .n_legs = 1, .detect_s = 1.0f};
+    im.h.contingency[RPAS_CT_C2_LOSS] = (rpas_plan_contingency_t){
+        .action = RPAS_CTA_PROCEDURE, .resume = 1, .first_leg = 5, .n_legs = 1, .detect_s = 1.0f};
+    mm_t mm;
+    mm_init(&mm, NULL);
+    ac_t a;
+    ac_init(&a);
+    world_t w = {.c2_up = true, .gps_ok = true, .fcs_mission = true, .agreed_crc = image_crc(&im)};
+    rpas_mm_status_msg_t st;
+    fly(&mm, &a, &w, &im, 10.0, &st);
+    CHECK(st.leg == 1);
+    w.fcs_mode = RPAS_MODE_DIRECT;
+    fly(&mm, &a, &w, NULL, 3.0, &st);
+    CHECK(st.contingency == RPAS_CT_AP_DISENGAGE && st.leg == 4);
+    w.c2_up = false;
+    fly(&mm, &a, &w, NULL, 3.0, &st);
+    CHECK(st.contingency == RPAS_CT_C2_LOSS && st.leg == 5);
+    w.c2_up = true;
+    w.fcs_mode = 0;
+    fly(&mm, &a, &w, NULL, 0.2, &st);
+    CHECK(st.state == RPAS_MM_ACTIVE && st.leg == 1 && st.contingency == 255);
+}
+
 static void test_gps_loss_hold_and_termination(void)
 {
     image_t im;
@@ -577,6 +608,7 @@ int main(void)
     RUN(test_altitude_terminators);
     RUN(test_hold_circuits);
     RUN(test_c2_loss_procedure_and_resume);
+    RUN(test_nested_contingencies);
     RUN(test_gps_loss_hold_and_termination);
     RUN(test_traffic_avoidance);
     RUN(test_pilot_commands);

@@ -375,9 +375,15 @@ static void detect(mm_t *mm, uint32_t cond, int64_t now, int64_t in_pilot_t)
             mm->cond_since[c] = -1;
             continue;
         }
-        if (mm->cond_since[c] < 0)
-            /* C2 loss: since the link was last heard (the pilot's frames come at 20 Hz) */
-            mm->cond_since[c] = c == RPAS_CT_C2_LOSS && in_pilot_t > 0 ? in_pilot_t : now;
+        if (mm->cond_since[c] < 0) {
+            /* C2 loss: since the link was last heard (the pilot's frames come at 20 Hz); any
+             * other: since the previous cycle, the latest instant it did not hold (it began
+             * after it: its detection time counts from the earliest it may have begun) */
+            if (c == RPAS_CT_C2_LOSS && in_pilot_t > 0)
+                mm->cond_since[c] = in_pilot_t;
+            else
+                mm->cond_since[c] = mm->prev_ns > 0 ? mm->prev_ns : now;
+        }
         if (age_s(now, mm->cond_since[c]) + 1e-9 >= h->contingency[c].detect_s)
             declared |= 1u << c;
     }
@@ -632,5 +638,6 @@ bool mm_step(mm_t *mm, const mm_inputs_t *in, int64_t now_ns, rpas_mission_msg_t
     status->to_go_m = mm->last.to_go_m;
     status->xte_m = mm->last.xte_m;
     status->alt_ref_ft = mm->last.alt_ft;
+    mm->prev_ns = now_ns;
     return out;
 }

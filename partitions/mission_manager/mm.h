@@ -227,6 +227,7 @@ typedef struct {
     uint32_t ct_flags;  /* bit k: contingency k's condition holds (declared) */
     int64_t cond_since[RPAS_CT_COUNT]; /* when each condition began to hold (-1: not) */
     int64_t ct_t0_ns;   /* when the contingency in force was declared */
+    int64_t prev_ns;    /* the previous cycle's time (0: none yet) */
     int resume_leg;     /* the mission leg to resume at */
     bool proc_started;
     bool engaged;       /* the flight control has flown MISSION since the plan was activated */

@@ -37,6 +37,8 @@ FLIGHTS = {
                "--pilot", DATA / "corrupt_uplink_pilot.yaml",
                "--replan", f"40:{DATA / 'contingencies.yaml'}",
                "--replan", f"100:{DATA / 'contingencies.yaml'}"],
+    "commands": ["--mission", MISSIONS / "tf_square.yaml", "--duration", "300",
+                 "--pilot", DATA / "commands_pilot.yaml"],
     "repeat1": ["--mission", MISSIONS / "tf_square.yaml", "--duration", "90", "--seed", "7"],
     "repeat2": ["--mission", MISSIONS / "tf_square.yaml", "--duration", "90", "--seed", "7"],
 }
@@ -194,8 +196,8 @@ def test_gps_loss_holds_and_resumes(flights):
     s = flights["contingencies"]
     reports = _reports(s)
     start = next(t for t, r in reports if "contingency gps_loss: procedure starts" in r)
-    # lost at 160 s; declared 1 s later, through io's frame and nav_fcs: two frames of chain
-    assert 161 <= start <= 161 + 2 * FRAME_S, start
+    # lost at 160 s; declared 1 s later, within a frame
+    assert 161 <= start <= 161 + FRAME_S, start
     assert any(t == start and "ORBIT" in r for t, r in reports)
     back = next(t for t, r in reports if "contingency gps_loss cleared" in r)
     assert 190 <= back <= 190 + 2 * FRAME_S, back
@@ -219,7 +221,7 @@ def test_autopilot_disengagement_holds_and_resumes(flights):
     s = flights["contingencies"]
     reports = _reports(s)
     start = next(t for t, r in reports if "contingency autopilot_disengage: procedure starts" in r)
-    assert 331 <= start <= 331 + 2 * FRAME_S, start
+    assert 331 <= start <= 331 + FRAME_S, start
     back = next(t for t, r in reports if "contingency autopilot_disengage cleared" in r)
     assert 345 <= back <= 347, back
 
@@ -236,6 +238,27 @@ def test_c2_loss_then_autopilot_disengagement_terminates_the_flight(flights):
     # the safe state: the engine cut (the throttle closes at its rate limit, 0.5 /s)
     after = [r for r in truth if r["t_ns"] / 1e9 > t["t_s"] + 3]
     assert after and all(r["thr"] == 0.0 for r in after)
+
+
+# ---- the pilot's mission commands ----------------------------------------------------------
+
+def test_pause_resume_direct_to_and_engage_are_flown(flights):
+    s = flights["commands"]
+    reports = _reports(s)
+
+    def at(text):
+        return next(t for t, r in reports if text in r)
+
+    # each command within two frames of the station's sending it (io, then the window)
+    assert 60 < at("mission_manager: paused at leg") <= 60 + 2 * FRAME_S
+    assert any(t >= 60 and "PAUSED" in r for t, r in reports)
+    assert 120 < at("mission_manager: resumed at leg") <= 120 + 2 * FRAME_S
+    assert 180 < at("mission_manager: direct to leg 4") <= 180 + 2 * FRAME_S
+    assert 240 < at("mission_manager: engaged: from the first leg") <= 240 + 2 * FRAME_S
+    # the direct-to flew to leg 4's fix (SQ1, the start), then on with leg 1 again after
+    # engaging: the judge sees leg 4 flown from its direct-to, and leg 1 twice
+    assert not s["crashed"]
+    assert s["mission"]["final_state"] == "ACTIVE"
 
 
 # ---- the uplink ------------------------------------------------------------------------------

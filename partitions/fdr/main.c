@@ -120,13 +120,10 @@ int main(int argc, char **argv)
         fail("no output file (ima:Linux OutputFile)", INVALID_CONFIG);
         return 1;
     }
-    for (int p = 0; p < P_COUNT; p++) {
-        const rpas_port_spec_t *ps = &fdr_port_spec[p];
-        rpas_create_port(ps, &app.ids[p], &rc);
-        if (rc != NO_ERROR) {
-            fail(ps->name, rc);
-            return 1;
-        }
+    const char *bad_port = rpas_create_ports(fdr_port_spec, P_COUNT, app.ids, &rc);
+    if (bad_port) {
+        fail(bad_port, rc);
+        return 1;
     }
     PARTITION_STATUS_TYPE status;
     GET_PARTITION_STATUS(&status, &rc);

@@ -339,12 +339,9 @@ int main(int argc, char *argv[])
                     (double)io.cfg.fault[k].spec.at_ns / 1e9);
     }
     RETURN_CODE_TYPE rc;
-    for (int p = 0; p < IO_PORT_COUNT; p++) {
-        const rpas_port_spec_t *s = &io_port_spec[p];
-        rpas_create_port(s, &io.port[p], &rc);
-        if (rc != NO_ERROR)
-            return fail(s->name, rc);
-    }
+    const char *bad_port = rpas_create_ports(io_port_spec, IO_PORT_COUNT, io.port, &rc);
+    if (bad_port)
+        return fail(bad_port, rc);
     void (*entry[IO_PROCESS_COUNT])(void) = {[IO_PROCESS_RX] = rx_process, [IO_PROCESS_TX] = tx_process};
     for (int i = 0; i < IO_PROCESS_COUNT; i++) {
         PROCESS_ID_TYPE pid;

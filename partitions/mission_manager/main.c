@@ -118,13 +118,10 @@ static void fail(const char *what, RETURN_CODE_TYPE rc)
 int main(void)
 {
     RETURN_CODE_TYPE rc;
-    for (int p = 0; p < P_COUNT; p++) {
-        const rpas_port_spec_t *ps = &mission_manager_port_spec[p];
-        rpas_create_port(ps, &app.id[p], &rc);
-        if (rc != NO_ERROR) {
-            fail(ps->name, rc);
-            return 1;
-        }
+    const char *bad_port = rpas_create_ports(mission_manager_port_spec, P_COUNT, app.id, &rc);
+    if (bad_port) {
+        fail(bad_port, rc);
+        return 1;
     }
     mm_init(&app.mm, NULL);
     const rpas_process_spec_t *ps = &mission_manager_process_spec[MISSION_MANAGER_PROCESS_MISSION];

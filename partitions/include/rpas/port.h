@@ -22,4 +22,18 @@ static inline void rpas_create_port(const rpas_port_spec_t *ps, long *id, RETURN
     }
 }
 
+/* Every port of a partition's contract table (spec[0..n-1]) into ids[]: NULL, or the name of
+ * the port that could not be created (*rc says why). */
+static inline const char *rpas_create_ports(const rpas_port_spec_t *spec, int n, long ids[],
+                                            RETURN_CODE_TYPE *rc)
+{
+    *rc = NO_ERROR;
+    for (int p = 0; p < n; p++) {
+        rpas_create_port(&spec[p], &ids[p], rc);
+        if (*rc != NO_ERROR)
+            return spec[p].name;
+    }
+    return NULL;
+}
+
 #endif

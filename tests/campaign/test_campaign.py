@@ -162,6 +162,17 @@ def test_rerun_flies_one_run_again_exactly(first):
     ({"faults": [{"class": "node_crash", "at_s": 99}]}, "after the end"),
     ({"faults": [{"name": "x", "specs": ["node1:node_crash@1", "node2:node_crash@after=f7"]}]},
      "f7"),
+    ({"workloads": {"autopilot": {"pilot": CAMPAIGN["workloads"]["autopilot"]["pilot"],
+                                  "mission": "no-such-plan.yaml"}}},
+     "workloads.autopilot.mission: no such file"),
+    ({"workloads": {"autopilot": {"pilot": CAMPAIGN["workloads"]["autopilot"]["pilot"],
+                                  "mission": str(ROOT / "config" / "campaigns" / "smoke.yaml")}}},
+     "workloads.autopilot.mission"),
+    ({"workloads": {"autopilot": {
+        "pilot": CAMPAIGN["workloads"]["autopilot"]["pilot"],
+        "mission": str(ROOT / "config" / "missions" / "campaign.yaml"),
+        "mission_feed": {"heading_deg": 90, "altitude_ft": 3000, "airspeed_kt": 100}}}},
+     "not both"),
 ])
 def test_a_bad_campaign_is_refused_naming_where(tmp_path, change, where):
     p = _ima("campaign", _campaign(tmp_path, **change), "--out", tmp_path / "o", check=False)

@@ -43,3 +43,16 @@ def test_every_class_is_injected_confirmed_and_judged(tmp_path):
         assert set(r["oracles"]) == {"confirmation", "temporal_isolation", "data_isolation",
                                      "detection", "hm_action", "degraded_mode", "envelope",
                                      "outcome"}, r["run_id"]
+    # the mission manager flying a real plan, lost on one node and on all: the flight control
+    # holds (MISSION_STALE) where it is lost; a single holding replica is voted out
+    plan = {r["run_id"]: r for r in records if r["workload"] == "plan"}
+    assert len(plan) == 3, sorted(plan)
+    for r in plan.values():
+        mode = r["oracles"]["degraded_mode"]
+        assert mode["verdict"] == "pass" and mode["faults"], (r["run_id"], mode)
+        assert all(f["expected"]["fallback"] == "MISSION_STALE" for f in mode["faults"])
+    one = next(r for rid, r in plan.items() if "partition_crash" in rid and "node2" in rid)
+    assert "node2 voted out" in one["readouts"]["degraded"], one["readouts"]
+    every = next(r for rid, r in plan.items() if "partition_crash" in rid and "node" not in
+                 rid.split("mission-manager")[1].split("-plan")[0])
+    assert not any("voted out" in d for d in every["readouts"]["degraded"]), every["readouts"]

@@ -148,7 +148,12 @@ def test_every_class_is_documented_and_in_both_shipped_campaigns() -> None:
     classes = set(catalogue.load())
     assert classes <= rows, sorted(classes - rows)
     assert f"one of the catalogue's {len(classes)} classes" in doc
+    from ima.campaign import spec
+
     for name in ("smoke", "full"):
-        camp = yaml.safe_load((ROOT / "config" / "campaigns" / f"{name}.yaml").read_text())
+        path = ROOT / "config" / "campaigns" / f"{name}.yaml"
+        camp = yaml.safe_load(path.read_text())
         used = {e["class"] for e in camp["faults"] if "class" in e}
         assert classes <= used, (name, sorted(classes - used))
+        # it expands into its runs: every target exists in the systems its workloads fly
+        assert {r.group for r in spec.load(path).runs} >= classes, name

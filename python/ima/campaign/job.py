@@ -32,6 +32,7 @@ def options(campaign: dict, run: dict, run_dir: Path, faults: list) -> LaunchOpt
         system=system_for(Path(campaign["dir"]), w, campaign["system"]),
         duration_s=campaign["duration_s"], seed=run["seed"], pilot=Path(w["pilot"]),
         turbulence=w["turbulence"], wind_kt=w["wind_kt"], run_dir=run_dir, kind="campaign",
+        mission=Path(w["mission"]) if w.get("mission") else None,
         realtime=bool(run.get("realtime")),
         faults=faults, judge=False, port_hashes=True, test_switches=list(
             campaign.get("test_switches") or []))

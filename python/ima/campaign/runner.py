@@ -44,7 +44,8 @@ def campaign_data(c: spec.Campaign, opts: RunnerOptions) -> dict:
         "duration_s": c.duration_s, "keep_all": opts.keep_all, "argv": list(opts.argv),
         "test_switches": list(opts.test_switches),
         "workloads": {w.name: {"name": w.name, "pilot": str(w.pilot), "turbulence": w.turbulence,
-                               "wind_kt": w.wind_kt, "mission_feed": w.mission_feed}
+                               "wind_kt": w.wind_kt, "mission_feed": w.mission_feed,
+                               "mission": None if w.mission is None else str(w.mission)}
                       for w in c.workloads.values()},
         "golden_of": {r.run_id: spec.golden_key(c, r) for r in c.runs},
     }

@@ -33,6 +33,7 @@ class Workload:
     turbulence: str = "light"
     wind_kt: float = 10.0
     mission_feed: dict | None = None
+    mission: Path | None = None  # a plan the mission manager flies (uplinked at run time)
 
 
 @dataclass(frozen=True)
@@ -96,9 +97,16 @@ def load(path: Path) -> Campaign:
     base = Path(path).resolve().parent
     workloads = {}
     for name, w in doc["workloads"].items():
+        if "mission" in w and "mission_feed" in w:
+            raise CampaignError(f"{path}: workloads.{name}: a plan (mission) or the stand-in "
+                                "feed (mission_feed), not both")
+        plan = None
+        if "mission" in w:
+            plan = _file(base, w["mission"], f"{path}: workloads.{name}.mission")
+            _check_plan(plan, f"{path}: workloads.{name}.mission")
         workloads[name] = Workload(name, _file(base, w["pilot"], f"{path}: workloads.{name}.pilot"),
                                    w.get("turbulence", "light"), float(w.get("wind_kt", 10.0)),
-                                   w.get("mission_feed"))
+                                   w.get("mission_feed"), plan)
     c = Campaign(name=doc["campaign"], path=Path(path).resolve(),
                  system=_file(base, doc["system"], f"{path}: system"),
                  duration_s=float(doc["duration_s"]), seeds=list(doc["seeds"]),
@@ -106,6 +114,17 @@ def load(path: Path) -> Campaign:
                  workloads=workloads, doc=doc)
     c.runs = expand(c)
     return c
+
+
+def _check_plan(plan: Path, where: str) -> None:
+    """A workload's mission plan must load and fit the uplink (ima mission check)."""
+    from ima.mission import image
+    from ima.mission import plan as mission_plan
+
+    try:
+        image.encode(mission_plan.load(plan))
+    except ImaError as exc:
+        raise CampaignError(f"{where}: {exc}") from exc
 
 
 def targets_of(system, cls: str) -> list[str]:
@@ -185,7 +204,10 @@ def expand(c: Campaign) -> list[RunSpec]:
             except ImaError as exc:
                 raise CampaignError(f"{where}: {exc}") from None
             sel = entry.get("targets", "all")
-            pool = targets_of(systems[loads[0]], cls)
+            # what every workload of the entry can be hit on (a workload that flies the
+            # stand-in mission feed has no mission manager)
+            pool = [t for t in targets_of(systems[loads[0]], cls)
+                    if all(t in targets_of(systems[w], cls) for w in loads[1:])]
             if sel == "all":
                 wheres = pool
             elif isinstance(sel, dict):
@@ -233,8 +255,11 @@ def resolved_doc(c: Campaign) -> dict:
     """The campaign file's content with its paths made absolute: the copy a campaign folder
     keeps (campaign.yaml), which `--resume` and `rerun` load wherever the folder is."""
     doc = dict(c.doc, system=str(c.system))
-    doc["workloads"] = {name: dict(w, pilot=str(c.workloads[name].pilot))
-                        for name, w in c.doc["workloads"].items()}
+    doc["workloads"] = {}
+    for name, w in c.doc["workloads"].items():
+        doc["workloads"][name] = dict(w, pilot=str(c.workloads[name].pilot))
+        if c.workloads[name].mission is not None:
+            doc["workloads"][name]["mission"] = str(c.workloads[name].mission)
     return doc
 
 

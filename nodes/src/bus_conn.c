@@ -129,6 +129,7 @@ void canbus__send_stop(canbus_bus_t *b, canbus_client_t *c, uint32_t reason)
  * the bus in here (well-behaved clients send far fewer datagrams per quantum). */
 void canbus__read_client(canbus_bus_t *b, canbus_client_t *c)
 {
+    c->more = true; /* until EAGAIN says otherwise */
     for (int k = 0; k < 1024 && !c->gone; k++) {
         struct iovec iov = {.iov_base = b->rxbuf, .iov_len = RXBUF_SIZE};
         struct msghdr m = {.msg_iov = &iov, .msg_iovlen = 1};
@@ -136,11 +137,13 @@ void canbus__read_client(canbus_bus_t *b, canbus_client_t *c)
         if (n < 0) {
             if (errno == EINTR)
                 continue;
+            c->more = false;
             if (errno != EAGAIN && errno != EWOULDBLOCK)
                 canbus__client_leave(b, c, "closed");
             return;
         }
         if (n == 0) {
+            c->more = false;
             canbus__client_leave(b, c, "closed");
             return;
         }
@@ -200,6 +203,7 @@ static void accept_all(canbus_bus_t *b)
         c->fd = fd;
         c->index = -1;
         c->pid = cred.pid;
+        c->more = true; /* its HELLO may be waiting already */
         b->live[b->n_live++] = c;
     }
 }
@@ -278,12 +282,16 @@ void canbus__service(canbus_bus_t *b, int64_t timeout_ns)
     reap(b);
 }
 
+/* What a client sends reaches the bus's socket within its own send call, so once every DONE
+ * is in, one poll shows every client with something to read: only those are read (no sweep
+ * of empty sockets), then once more those a read left at its bound (a flooding client is
+ * read at most twice the bound per quantum) and those just accepted. */
 void canbus__read_all(canbus_bus_t *b)
 {
     canbus__service(b, 0);
     accept_all(b);
     for (size_t i = 0; i < b->n_live; i++)
-        if (!b->live[i]->gone)
+        if (!b->live[i]->gone && b->live[i]->more)
             canbus__read_client(b, b->live[i]);
     reap(b);
 }

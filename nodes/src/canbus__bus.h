@@ -108,6 +108,7 @@ typedef struct canbus_client {
     size_t q_head, q_len, q_cap;
     int64_t q_progress_wall; /* last time the queue moved */
     canbus_sbuf_t staged;    /* trace lines of this quantum, written in index order */
+    bool more;               /* the last read stopped at its bound: datagrams may be left */
 } canbus_client_t;
 
 typedef struct canbus_bus {

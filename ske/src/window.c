@@ -10,7 +10,6 @@
 #include <string.h>
 #include <time.h>
 
-#define SPIN_NS 40000 /* busy-wait this long for a yield before sleeping on the futex */
 #define HANG_FACTOR 20 /* emulated mode: a window may take this many times its length in wall */
 #define HANG_MIN_NS 2000000000LL /* time (at least 2 s) while using no CPU before it is cut */
 /* A partition that handed the CPU back has a few microseconds of system-call tail; more than
@@ -54,14 +53,9 @@ static wres_t wait_yield(ske_t *s, ske_part_t *p, int64_t budget_ns, int64_t end
                          int64_t cpu0, ov_cause_t *cause)
 {
     int64_t t0 = ske_mono_ns();
-    /* Most windows of a light partition end within microseconds: notice that at once. */
-    for (uint32_t i = 1;; i++) {
-        if (yielded(p))
-            return W_YIELD;
-        cpu_relax();
-        if ((i & 63) == 0 && (ske_mono_ns() - t0 > SPIN_NS || s->child_event || s->stop_signal))
-            break;
-    }
+    /* No busy-waiting: the SKE sleeps on the futex at once and the partition's yield wakes
+     * it. On one CPU a spinning SKE would only delay the partition it waits for; on two, a
+     * futex hand-off costs a few microseconds (docs/performance.md). */
     for (;;) {
         if (yielded(p))
             return W_YIELD;

@@ -102,12 +102,12 @@ def measure(duration_s: float, runs: int, jobs: int, folder: Path) -> dict:
 def run(json_out: bool, runs_60: int = 8, runs_300: int = 6) -> int:
     from rich.console import Console
 
-    from ima.bench.flight import RssSampler
+    from ima.bench.cpu import Sampler
 
     console = Console(stderr=True)
     cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1
     results: dict = {"cpus": cpus, "cases": []}
-    with tempfile.TemporaryDirectory(prefix="ima-bench-campaign-") as tmp, RssSampler() as rss:
+    with tempfile.TemporaryDirectory(prefix="ima-bench-campaign-") as tmp, Sampler() as rss:
         for duration, n in ((60.0, runs_60), (300.0, runs_300)):
             for jobs in (1, 2):
                 with console.status(f"campaign of {n} runs of {duration:g} s at -j {jobs}"):

@@ -20,10 +20,12 @@ from ima.errors import ImaError
 
 # The figures compared per benchmark, and whether more is better.
 FIGURES = {
-    "ske": {"window_switch_us_median": False, "major_frames_per_s": True,
-            "sampling_rw_ns_median": False},
-    "flight": {"speedup": True, "peak_rss_mb": False},
-    "triplex": {"speedup": True, "peak_rss_mb": False, "dds_latency_us_median": False},
+    "ske": {"window_switch_us_median": False, "window_switch_us_median_pinned": False,
+            "major_frames_per_s": True, "sampling_rw_ns_median": False},
+    "flight": {"speedup": True, "speedup_pinned": True, "aggregate_speedup": True,
+               "peak_rss_mb": False},
+    "triplex": {"speedup": True, "speedup_pinned": True, "aggregate_speedup": True,
+                "peak_rss_mb": False, "dds_latency_us_median": False},
 }
 
 

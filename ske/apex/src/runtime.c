@@ -57,7 +57,7 @@ void apex__yield_cpu(void)
     atomic_store(&c->yield_mono_ns, ske_mono_ns());
     /* Sequentially consistent store then load, against the SKE's store of ske_sleeping then
      * load of yield_seq: one of the two always sees the other, so no wake-up is lost, and
-     * the system call is saved while the SKE spins (the usual case). */
+     * the system call is saved when the SKE has not gone to sleep yet. */
     atomic_store(&c->yield_seq, rt->seen_grant);
     if (atomic_load(&c->ske_sleeping))
         ske_futex_wake(&c->yield_seq);

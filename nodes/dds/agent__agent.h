@@ -222,6 +222,8 @@ void agent_dds_process_events(agent_t *a);
 void agent_dds_take_all(agent_t *a);
 bool agent_dds_discovery_complete(agent_t *a, uint32_t *missing);
 int agent_dds_publish(agent_t *a, int topic, const struct xch_hdr *h, const void *payload);
+/* Whether the agent reads a topic from the other nodes (it writes every topic). */
+bool agent_reads_topic(int topic);
 void agent_dds_withdraw(agent_t *a);
 unsigned agent_dds_bind_sockets(agent_t *a);
 /* Emulated time: latches as hung the peers of `missing` that are silent (see agent_dds.c);

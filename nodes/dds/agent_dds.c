@@ -175,6 +175,9 @@ int agent_dds_start(agent_t *a)
         }
     }
     for (int t = 0; t < T_COUNT; t++) {
+        a->rd[t] = 0;
+        if (!agent_reads_topic(t))
+            continue; /* no reader: the peers' samples of it are not even sent here */
         a->rd_ctx[t] = (agent_rd_ctx_t){a, t};
         dds_listener_t *l = dds_create_listener(&a->rd_ctx[t]);
         dds_lset_data_available(l, on_data_available);
@@ -192,7 +195,9 @@ int agent_dds_start(agent_t *a)
                     agent_topic_name[t], dds_strretcode(a->rd[t]));
             return -1;
         }
-        q = endpoint_qos(a, t, true);
+    }
+    for (int t = 0; t < T_COUNT; t++) {
+        dds_qos_t *q = endpoint_qos(a, t, true);
         a->wr[t] = dds_create_writer(a->pub, a->tp[t], q, NULL);
         dds_delete_qos(q);
         if (a->wr[t] < 0) {
@@ -442,7 +447,7 @@ bool agent_dds_discovery_complete(agent_t *a, uint32_t *missing)
         if (k == a->o.node)
             continue;
         for (int t = 0; t < T_COUNT; t++)
-            if (!a->peer[k - 1].matched[t])
+            if (agent_reads_topic(t) && !a->peer[k - 1].matched[t])
                 m |= 1u << (k - 1);
     }
     if (missing)
@@ -495,6 +500,13 @@ static void inputs_to_dds(rpas_CrossChannelInputs *s, const struct xch_inputs *x
 
 #define TAKE_MAX 32
 
+bool agent_reads_topic(int topic)
+{
+    /* The cross-channel exchange and node health; telemetry and mission data are for the
+     * ground (a listener, a station), not for the other nodes. */
+    return topic == T_INPUTS || topic == T_HEALTH;
+}
+
 static void take_topic(agent_t *a, int t)
 {
     static union {
@@ -507,7 +519,7 @@ static void take_topic(agent_t *a, int t)
     dds_sample_info_t si[TAKE_MAX];
     for (int i = 0; i < TAKE_MAX; i++)
         ptrs[i] = &buf[i];
-    for (;;) {
+    while (a->rd[t] > 0) {
         int32_t n = dds_take(a->rd[t], ptrs, si, TAKE_MAX, TAKE_MAX);
         if (n <= 0)
             return;

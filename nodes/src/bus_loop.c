@@ -99,6 +99,14 @@ static int deliver(canbus_bus_t *b, int64_t t, bool tick)
             if (!c->gone && c->index >= 0 && c->member_next) {
                 c->member = true;
                 c->member_next = false;
+                c->need_ns = 0;
+            }
+            /* A member with nothing to do before the end of this quantum (its DONE said when
+             * it next has work) is not granted it: it is done with it already. */
+            if (!c->gone && c->index >= 0 && c->member) {
+                c->skip = c->need_ns > 0 && b->t_next <= c->need_ns;
+                c->done = c->skip;
+                c->ticks_skipped += c->skip;
             }
         }
     for (int pass = 0; pass < 2; pass++) {
@@ -106,7 +114,7 @@ static int deliver(canbus_bus_t *b, int64_t t, bool tick)
             canbus_client_t *c = b->live[i];
             if (c->gone || c->index < 0)
                 continue;
-            bool ticked = c->member && tick;
+            bool ticked = c->member && tick && !c->skip;
             if (ticked != (pass == 1))
                 continue;
             size_t n = 0;
@@ -128,6 +136,7 @@ static int deliver(canbus_bus_t *b, int64_t t, bool tick)
             }
             if (ticked) {
                 c->done = false;
+                c->ticks++;
                 b->out[n++] = (struct canbus_rec){.type = CANBUS_MSG_TICK, .t_ns = b->t_next,
                                                   .aux = t};
                 if (b->o.realtime) /* data = the release lateness, ns, little-endian */

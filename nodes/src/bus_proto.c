@@ -226,6 +226,7 @@ void canbus__handle_records(canbus_bus_t *b, canbus_client_t *c, const uint8_t *
                 break;
             }
             c->done = true;
+            c->need_ns = r.aux; /* proto.h: the instant it next has work at, or 0 */
             break;
         case CANBUS_MSG_STOP: /* the world's after a crash; a tool's is not its to send */
             if (c->roles & CANBUS_ROLE_LOCKSTEP)

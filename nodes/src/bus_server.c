@@ -130,12 +130,14 @@ int canbus_bus_write_stats(canbus_bus_t *b, const char *path)
                 ",\"rejected\":%" PRIu64 ",\"clamped\":%" PRIu64 ",\"overflow\":%" PRIu64
                 ",\"tx_ok\":%" PRIu64
                 ",\"tx_errors\":%" PRIu64 ",\"dropped\":%" PRIu64 ",\"bus_off_events\":%" PRIu64
-                ",\"tec\":%u,\"rec\":%u,\"state\":\"%s\",\"left\":%s,\"listen_only\":%s}",
+                ",\"tec\":%u,\"rec\":%u,\"state\":\"%s\",\"left\":%s,\"listen_only\":%s"
+                ",\"ticks\":%" PRIu64 ",\"ticks_skipped\":%" PRIu64 "}",
                 i ? "," : "", i, (int)c->jname.n, c->jname.p, c->roles, c->tx, c->rx,
                 c->rejected, c->clamped, c->overflow, k->tx_ok, k->tx_err, k->dropped,
                 k->bus_off_events,
                 k->tec, k->rec, canbus__state_name(canbus_wire_state(w, (uint8_t)i)),
-                c->gone ? "true" : "false", c->listen_only ? "true" : "false");
+                c->gone ? "true" : "false", c->listen_only ? "true" : "false", c->ticks,
+                c->ticks_skipped);
     }
     /* Who ended the run (null: it reached its end), and what the bus refused. */
     canbus_sbuf_t *s = &b->line;

@@ -101,6 +101,9 @@ typedef struct canbus_client {
     bool member;      /* takes part in the current quantum */
     bool member_next; /* joined as LOCKSTEP after the start: takes part from the next one */
     bool done;        /* sent DONE for the current quantum */
+    int64_t need_ns;  /* its last DONE's aux: no TICK needed while the grant would be <= it */
+    uint64_t ticks, ticks_skipped; /* quanta it was granted, and those it did not need */
+    bool skip;                     /* not granted the current quantum */
     bool gone;
     const char *leave_reason;
     uint64_t tx, rx, rejected, clamped, overflow;

@@ -209,13 +209,19 @@ int canbus_client_recv(canbus_client_t *c, struct canbus_rec *rec)
 
 int canbus_client_done_wait(canbus_client_t *c)
 {
+    return canbus_client_done_wait_for(c, 0);
+}
+
+int canbus_client_done_wait_for(canbus_client_t *c, int64_t need_ns)
+{
     int rc;
     if (c->stopped)
         return CANBUS_STOPPED;
     if (!c->waiting) {
         /* Before the first TICK there is nothing to report done. */
         if (c->ticked) {
-            struct canbus_rec r = {.type = CANBUS_MSG_DONE, .t_ns = c->granted_ns};
+            struct canbus_rec r = {.type = CANBUS_MSG_DONE, .t_ns = c->granted_ns,
+                                   .aux = need_ns > c->granted_ns ? need_ns : 0};
             if ((rc = queue_out(c, &r)) != 0)
                 return rc;
         }

@@ -113,11 +113,12 @@ fail:
 }
 
 /* Lockstep: a window starting at t runs only once the bus has granted time past t; until then
- * the node reports its quantum done and waits for the next one (nodes/include/canbus/proto.h). */
+ * the node reports its quantum done and waits (nodes/include/canbus/proto.h). Its DONE says
+ * that nothing is to be done before t: the bus does not grant the quanta in between. */
 static int wait_for_quantum(ske_t *s, int64_t t, char *err, size_t errlen)
 {
     while (t >= s->bus.granted_ns) {
-        int r = canbus_client_done_wait(&s->bus);
+        int r = canbus_client_done_wait_for(&s->bus, t);
         if (r == CANBUS_STOPPED) {
             s->bus_stopped = true;
             return SKE_OK;

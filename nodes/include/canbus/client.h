@@ -62,6 +62,9 @@ int canbus_client_recv(canbus_client_t *c, struct canbus_rec *rec);
  * next TICK (frames arriving meanwhile are kept for canbus_client_recv). Returns CANBUS_OK with
  * granted_ns advanced, CANBUS_STOPPED when the run is over, or a negative errno. */
 int canbus_client_done_wait(canbus_client_t *c);
+/* The same, telling the bus that nothing is to be done before need_ns: the bus grants no
+ * quantum ending at or before it (proto.h); 0: every quantum. */
+int canbus_client_done_wait_for(canbus_client_t *c, int64_t need_ns);
 /* Asks the bus to end the run for everyone. */
 int canbus_client_request_stop(canbus_client_t *c);
 void canbus_client_close(canbus_client_t *c);

@@ -38,7 +38,10 @@
  *   Frames from clients without the LOCKSTEP role (tools) are stamped by the bus with the
  *   start of the quantum in which it reads them.
  *   A node whose SKE is a LOCKSTEP client runs a window starting at s only once it holds a
- *   TICK with t_ns > s; before a window starting at or after the granted time it sends DONE.
+ *   TICK with t_ns > s; before a window starting at or after the granted time it sends DONE
+ *   with aux = s: the bus grants it no quantum [T, T+Q) with T+Q <= s (it counts as done
+ *   in those), so a node is woken only for the quanta in which a window of it starts. The
+ *   quanta, the frames' delivery and the wire are the same for every client either way.
  *
  * Real time (--realtime on the bus): the same exchange, but the bus sends the TICK for [T, T+Q)
  * no earlier than epoch + T on CLOCK_MONOTONIC.
@@ -98,7 +101,8 @@ enum canbus_rec_type {
     CANBUS_MSG_TICK = 2,  /* bus -> LOCKSTEP client: advance to t_ns; aux = start of the quantum;
                              a --realtime bus: data = how late it released the quantum on its
                              wall clock (int64 ns, little-endian), else zeros */
-    CANBUS_MSG_DONE = 3,  /* LOCKSTEP client -> bus: finished everything before t_ns */
+    CANBUS_MSG_DONE = 3,  /* LOCKSTEP client -> bus: finished everything before t_ns; aux > t_ns:
+                             nothing to do before aux (no TICK wanted up to it), else 0 */
     CANBUS_MSG_STOP = 4,  /* bus -> client: the run ends; id = CANBUS_STOP_* reason. LOCKSTEP
                              client or control channel -> bus: end the run */
     CANBUS_MSG_ERROR = 5, /* bus -> CAN clients: an error frame on the wire (id = the frame's

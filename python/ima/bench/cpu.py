@@ -1,16 +1,14 @@
 # SPDX-License-Identifier: Apache-2.0
 """Where a flight's CPU time goes: the CPU time (user + system, from the kernel's accounting in
 /proc) of every process of a run, summed by kind (the bus, the world, each node's SKE and DDS
-agent, each partition, the launcher itself), and its peak resident memory. A sampler thread
-reads the launcher's descendants every `period_s`; a process's last reading counts, so what a
-process spends after it (at most one period at its very end) is not seen."""
+agent, each partition, `ima launch` itself, the recorder), and its peak resident memory. A
+sampler thread reads this process's descendants every `period_s`; a process's last reading
+counts, so what a process spends after it (at most one period at its very end) is not seen."""
 
 from __future__ import annotations
 
 import os
-import resource
 import threading
-import time
 
 _PAGE = os.sysconf("SC_PAGE_SIZE")
 _TICK = os.sysconf("SC_CLK_TCK")
@@ -50,7 +48,14 @@ def _kind(pid: int, ppid: int) -> str:
                 cmd = f.read()
         except OSError:
             return "other"
-        return "world" if b"imaworld" in cmd else "other"
+        args = cmd.split(b"\0")
+        if b"imaworld" in args:
+            return "world"
+        if b"ima.recording" in args:
+            return "recorder"
+        if b"ima" in args and b"launch" in args:
+            return "launcher"
+        return "other"
     return "other"
 
 
@@ -77,11 +82,8 @@ class Sampler:
         self.period_s = period_s
         self.peak = 0
         self._ticks: dict[int, tuple[str, int]] = {}  # pid -> (kind, last CPU ticks)
-        self._own = 0.0  # the sampler's own CPU seconds (not the launcher's)
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._loop, daemon=True)
-        self._usage0 = resource.getrusage(resource.RUSAGE_SELF)
-        self._usage1 = self._usage0
 
     def _sample(self, me: int) -> None:
         rss = 0
@@ -102,27 +104,20 @@ class Sampler:
         me = os.getpid()
         while not self._stop.wait(self.period_s):
             self._sample(me)
-        self._own = time.thread_time()
 
     def __enter__(self) -> Sampler:
-        self._usage0 = resource.getrusage(resource.RUSAGE_SELF)
         self._thread.start()
         return self
 
     def __exit__(self, *exc: object) -> None:
-        self._usage1 = resource.getrusage(resource.RUSAGE_SELF)
         self._stop.set()
         self._thread.join()
 
     def cpu_s_by_kind(self) -> dict[str, float]:
-        """CPU seconds of each kind of process; `launcher` is this process (the launch, its
-        live view and the summary), without the sampler's own time."""
+        """CPU seconds of each kind of process among the descendants."""
         out: dict[str, float] = {}
         for kind, ticks in self._ticks.values():
             out[kind] = out.get(kind, 0.0) + ticks / _TICK
-        u0, u1 = self._usage0, self._usage1
-        out["launcher"] = max(0.0, (u1.ru_utime + u1.ru_stime) - (u0.ru_utime + u0.ru_stime)
-                              - self._own)
         return out
 
 

@@ -20,7 +20,6 @@ from ima.bench import cpu as cpu_sampler
 from ima.bench import floor
 from ima.errors import ImaError
 from ima.launch import options as launch_options
-from ima.launch import run as launch_run
 
 TARGETS = {"speedup": 50.0, "speedup_pinned": 250.0, "aggregate_speedup": 450.0,
            "canbus_frames_per_s": 100_000.0, "peak_rss_mb": 300.0}
@@ -46,39 +45,51 @@ def _truth_sha256(run_dir: Path) -> str:
     return hashlib.sha256((run_dir / "truth.jsonl").read_bytes()).hexdigest()
 
 
+def _launch_cmd(system: Path, duration_s: float, seed: int, run_dir: Path) -> list[str]:
+    """`ima launch` with its defaults (deployment, traces, DDS Security, the recording, the
+    summary and its plot), as a user runs it; --json, so nobody watches a live view."""
+    return [sys.executable, "-m", "ima", "launch", str(system), "--duration", f"{duration_s:g}",
+            "--seed", str(seed), "--json", "--run-dir", str(run_dir)]
+
+
 def fly_once(system: Path, duration_s: float, seed: int, console, cpu: int | None = None,
              what: str = "") -> dict:
-    """One run of `system` as `ima launch` runs it with its defaults (deployment, traces, DDS
-    Security, the recording): emulated time flown, wall time, speed-up, the peak memory of
-    all its processes and their CPU time by kind; with `cpu`, every process of the flight (this
-    one too) pinned to that CPU."""
-    saved = os.sched_getaffinity(0)
+    """One `ima launch` of `system`: emulated time flown, wall time (from the command's start
+    to its end: deployment and summary included), speed-up, the peak memory of all its
+    processes and their CPU time by kind; with `cpu`, every process of it pinned to that
+    CPU."""
     with tempfile.TemporaryDirectory(prefix="ima-bench-") as tmp:
-        opts = launch_options.LaunchOptions(system=system, duration_s=duration_s, seed=seed,
-                                            run_dir=Path(tmp) / "run")
+        run_dir = Path(tmp) / "run"
         where = "floating" if cpu is None else f"pinned to CPU {cpu}"
+        pin = None if cpu is None else functools.partial(os.sched_setaffinity, 0, {cpu})
         with console.status(f"flying {system.stem} {duration_s:g} s (seed {seed}, light "
                             f"turbulence), {where}{what}"):
-            try:
-                if cpu is not None:
-                    os.sched_setaffinity(0, {cpu})
-                with cpu_sampler.Sampler() as sampler:
-                    t0 = time.monotonic()
-                    result = launch_run.launch(opts)
-                    wall = time.monotonic() - t0
-            finally:
-                os.sched_setaffinity(0, saved)
-        failed = {k: v for k, v in result.returncodes.items() if v not in (0, None)}
+            with cpu_sampler.Sampler() as sampler:
+                t0 = time.monotonic()
+                done = subprocess.run(_launch_cmd(system, duration_s, seed, run_dir),
+                                      capture_output=True, text=True, cwd=paths.repo_root(),
+                                      preexec_fn=pin)
+                wall = time.monotonic() - t0
+        if done.returncode != 0:
+            raise ImaError(f"benchmark run failed ({done.returncode}): "
+                           f"{done.stderr.strip()[-500:]}")
+        try:
+            summary = json.loads(done.stdout)
+        except ValueError as exc:
+            raise ImaError(f"ima launch printed no summary: {done.stdout[-300:]!r}") from exc
+        failed = {k: v for k, v in (summary.get("returncodes") or {}).items()
+                  if v not in (0, None)}
         if failed:
             raise ImaError(f"benchmark run failed: {failed}")
-        flown = _flown_s(result.run_dir)
-        sha = _truth_sha256(result.run_dir)
-        cpu = {k: v for k, v in sampler.cpu_s_by_kind().items()
-               if not k.startswith("partition:")}
-        cpu.update(_partitions_cpu_s(result.run_dir))
-    return {"nodes": len(result.nodes), "flight_s": round(flown, 1), "wall_s": round(wall, 2),
-            "speedup": round(flown / wall, 1), "peak_rss_mb": round(sampler.peak / 2**20, 1),
-            "cpu_ms_per_emulated_s": cpu_sampler.per_emulated_s(cpu, flown),
+        flown = _flown_s(run_dir)
+        sha = _truth_sha256(run_dir)
+        cpu_s = {k: v for k, v in sampler.cpu_s_by_kind().items()
+                 if not k.startswith("partition:")}
+        cpu_s.update(_partitions_cpu_s(run_dir))
+    return {"nodes": len(summary.get("nodes") or []), "flight_s": round(flown, 1),
+            "wall_s": round(wall, 2), "speedup": round(flown / wall, 1),
+            "peak_rss_mb": round(sampler.peak / 2**20, 1),
+            "cpu_ms_per_emulated_s": cpu_sampler.per_emulated_s(cpu_s, flown),
             "truth_sha256": sha}
 
 
@@ -108,9 +119,7 @@ def fly_aggregate(system: Path, duration_s: float, seed: int, console) -> dict:
             t0 = time.monotonic()
             for k, c in enumerate(cpus):
                 run_dir = Path(tmp) / f"run{k}"
-                cmd = [sys.executable, "-m", "ima", "launch", str(system), "--duration",
-                       f"{duration_s:g}", "--seed", str(seed + k), "--json", "--run-dir",
-                       str(run_dir)]
+                cmd = _launch_cmd(system, duration_s, seed + k, run_dir)
                 procs.append((run_dir, subprocess.Popen(
                     cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                     cwd=paths.repo_root(), preexec_fn=functools.partial(

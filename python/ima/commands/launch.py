@@ -237,13 +237,18 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
     # the recording follows the traces while the run flies (on the CPU the lockstep leaves)
     recorder = recording.start(Path(opts.run_dir), nodes) if record else None
     try:
-        with Live(progress, console=console, transient=True, refresh_per_second=4) as live:
-            def on_status(st: dict) -> None:
-                state.update(st)
-                progress.update(task, completed=min(st.get("t_s", 0), opts.duration_s))
-                live.update(Group(state.render(), progress))
+        if not console.is_terminal:
+            # nobody watches (a pipe, a file, a campaign, a benchmark): no live view to
+            # follow the traces for and draw
+            result = launch_run.launch(opts)
+        else:
+            with Live(progress, console=console, transient=True, refresh_per_second=4) as live:
+                def on_status(st: dict) -> None:
+                    state.update(st)
+                    progress.update(task, completed=min(st.get("t_s", 0), opts.duration_s))
+                    live.update(Group(state.render(), progress))
 
-            result = launch_run.launch(opts, on_status=on_status)
+                result = launch_run.launch(opts, on_status=on_status)
     except BaseException:
         recording.abandon(recorder, Path(opts.run_dir))
         raise

@@ -1,7 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
-"""`ima bench flight`: speed-up of a 10-minute single-node flight (`ima fly`: the simplex system
-launched), CAN bus throughput with four clients, and the peak memory of the whole flight
-(every process of it, summed)."""
+"""`ima bench flight`: a 10-minute single-node flight (`ima launch` of the simplex system, with
+its defaults) flown three ways: floating (`speedup`), pinned to one CPU (`speedup_pinned`, and
+the CPU time per emulated second of each kind of process), one flight per CPU at once
+(`aggregate_speedup`); the floor of its cost (ima.bench.floor); the peak memory of the whole
+flight (every process of it, summed); then CAN bus throughput with four clients
+(docs/performance.md)."""
 
 from __future__ import annotations
 

@@ -1,9 +1,11 @@
 # SPDX-License-Identifier: Apache-2.0
 """`ima bench triplex`: the redundant system at work.
 
-- speedup: emulated seconds per wall second of a 10-minute flight of
-  config/systems/rpas_triplex.yaml (3 nodes, each an SKE with its partitions and a DDS agent,
-  the CAN bus, the world), in emulated time;
+- speedup, speedup_pinned, aggregate_speedup, cpu_ms_per_emulated_s, floor: a 10-minute flight
+  of config/systems/rpas_triplex.yaml (3 nodes, each an SKE with its partitions and a DDS
+  agent, the CAN bus, the world) by `ima launch` with its defaults, flown three ways as
+  `ima bench flight` flies its own (ima.bench.flight); truth_identical_to_reference: its
+  truth against the one recorded before the lockstep was made cheaper;
 - peak_rss_mb: the peak of the summed resident memory of every process of that run;
 - dds_latency_us_median: node-to-node latency of DDS between two of the product's agents in
   real-time mode (one agent's dds_write to the other's take), next to

@@ -54,8 +54,11 @@ static wres_t wait_yield(ske_t *s, ske_part_t *p, int64_t budget_ns, int64_t end
 {
     int64_t t0 = ske_mono_ns();
     /* No busy-waiting: the SKE sleeps on the futex at once and the partition's yield wakes
-     * it. On one CPU a spinning SKE would only delay the partition it waits for; on two, a
-     * futex hand-off costs a few microseconds (docs/performance.md). */
+     * it. Pinned to one CPU, where flights run (one per CPU), a spinning SKE would only delay
+     * the partition it waits for, and a window switch costs two context switches (≈ 7 µs
+     * here). Floating over two CPUs the wake-up crosses CPUs (≈ 30 µs on these virtual
+     * machines, where a 40 µs spin took 12 µs and burnt the other CPU meanwhile):
+     * docs/performance.md. */
     for (;;) {
         if (yielded(p))
             return W_YIELD;

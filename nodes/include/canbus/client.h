@@ -63,7 +63,9 @@ int canbus_client_recv(canbus_client_t *c, struct canbus_rec *rec);
  * granted_ns advanced, CANBUS_STOPPED when the run is over, or a negative errno. */
 int canbus_client_done_wait(canbus_client_t *c);
 /* The same, telling the bus that nothing is to be done before need_ns: the bus grants no
- * quantum ending at or before it (proto.h); 0: every quantum. */
+ * quantum ending at or before it (proto.h); 0: every quantum. A CAN client is still sent the
+ * frames of the quanta it skips, without a TICK: they wait in its receive queue (which keeps
+ * the newest CANBUS_IN_RECS), so a client that must see every frame asks for every quantum. */
 int canbus_client_done_wait_for(canbus_client_t *c, int64_t need_ns);
 /* Asks the bus to end the run for everyone. */
 int canbus_client_request_stop(canbus_client_t *c);

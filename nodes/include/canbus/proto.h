@@ -22,14 +22,16 @@
  *   a. The bus sends every CAN client, in one datagram, the FRAME records of all frames whose
  *      transmission ended at or before T and that it has not delivered yet, in the order they
  *      were on the bus (t_ns = end of frame, aux = start of frame, src = sender's client
- *      index); then it sends TICK(t_ns = T+Q, aux = T) to every LOCKSTEP client.
+ *      index); then it sends TICK(t_ns = T+Q, aux = T) to every LOCKSTEP client that has not
+ *      said it has nothing to do in [T, T+Q) (below).
  *   b. A LOCKSTEP client advances its own time to T+Q (exclusive): it may send FRAME records
  *      stamped with their request times (any time >= T; frames stamped past T+Q simply wait
  *      for their time), then it sends DONE(t_ns = T+Q). Frames and the DONE may share a
  *      datagram (frames first).
- *   c. When every LOCKSTEP client has sent DONE(T+Q), the bus reads every socket dry (a client
- *      that wrote a frame before its node's DONE was sent has it queued by then: AF_UNIX
- *      queues at send time), then simulates the wire through [T, T+Q): whenever the bus is
+ *   c. When every LOCKSTEP client has sent DONE(T+Q), the bus reads every socket a poll shows
+ *      readable, dry (a client that wrote a frame before its node's DONE was sent has it
+ *      queued by then: AF_UNIX queues at send time), then simulates the wire through
+ *      [T, T+Q): whenever the bus is
  *      idle, the pending frames requested at or before that instant arbitrate and the lowest
  *      identifier wins (ties: lower client index, then request order); a frame occupies the
  *      wire for its worst-case-stuffed length (canbus_frame_bits() below).

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Where a flight's CPU time goes: the CPU time (user + system, from the kernel's accounting in
-/proc) of every process of a run, summed by kind (the bus, the world, each node's SKE and DDS
-agent, each partition, `ima launch` itself, the recorder), and its peak resident memory. A
+/proc) of every process of a run, summed by kind (the bus, the world, the SKEs, the DDS
+agents, each partition, `ima launch` itself, the recorder), and its peak resident memory. A
 sampler thread reads this process's descendants every `period_s`; a process's last reading
 counts, so what a process spends after it (at most one period at its very end) is not seen."""
 
@@ -16,8 +16,8 @@ _TICK = os.sysconf("SC_CLK_TCK")
 _KINDS = {"ima-ske": "ske", "ima-canbus": "bus", "ima-dds-node": "dds_agent"}
 
 
-def _stat(pid: int) -> tuple[int, int] | None:
-    """(parent pid, CPU ticks) of a process."""
+def _stat(pid: int) -> tuple[int, int, int] | None:
+    """(parent pid, CPU ticks, start time) of a process."""
     try:
         with open(f"/proc/{pid}/stat", "rb") as f:
             stat = f.read()
@@ -25,7 +25,7 @@ def _stat(pid: int) -> tuple[int, int] | None:
         return None
     # the command name may hold spaces and parentheses: fields start after the last ')'
     fields = stat[stat.rindex(b")") + 2:].split()
-    return int(fields[1]), int(fields[11]) + int(fields[12])
+    return int(fields[1]), int(fields[11]) + int(fields[12]), int(fields[19])
 
 
 def _comm(pid: int) -> str:
@@ -81,7 +81,8 @@ class Sampler:
     def __init__(self, period_s: float = 0.1) -> None:
         self.period_s = period_s
         self.peak = 0
-        self._ticks: dict[int, tuple[str, int]] = {}  # pid -> (kind, last CPU ticks)
+        # (pid, start time): a pid the kernel gives again is another process
+        self._ticks: dict[tuple[int, int], tuple[str, int]] = {}  # -> (kind, last CPU ticks)
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._loop, daemon=True)
 
@@ -92,7 +93,7 @@ class Sampler:
             if st is None:
                 continue
             # classified anew each time: a process just forked still has its parent's name
-            self._ticks[pid] = (_kind(pid, st[0]), st[1])
+            self._ticks[(pid, st[2])] = (_kind(pid, st[0]), st[1])
             try:
                 with open(f"/proc/{pid}/statm") as f:
                     rss += int(f.read().split()[1]) * _PAGE

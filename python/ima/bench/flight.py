@@ -8,7 +8,7 @@ flight (every process of it, summed); then CAN bus throughput with four clients
 
 from __future__ import annotations
 
-import functools
+import contextlib
 import hashlib
 import json
 import os
@@ -55,6 +55,21 @@ def _launch_cmd(system: Path, duration_s: float, seed: int, run_dir: Path) -> li
             "--seed", str(seed), "--json", "--run-dir", str(run_dir)]
 
 
+@contextlib.contextmanager
+def _pinned(cpu: int | None):
+    """This thread pinned to `cpu` meanwhile (what it starts inherits it), then as before. Not
+    a preexec_fn: a fork while other threads run must not run Python code in the child."""
+    if cpu is None:
+        yield
+        return
+    saved = os.sched_getaffinity(0)
+    os.sched_setaffinity(0, {cpu})
+    try:
+        yield
+    finally:
+        os.sched_setaffinity(0, saved)
+
+
 def fly_once(system: Path, duration_s: float, seed: int, console, cpu: int | None = None,
              what: str = "") -> dict:
     """One `ima launch` of `system`: emulated time flown, wall time (from the command's start
@@ -64,15 +79,17 @@ def fly_once(system: Path, duration_s: float, seed: int, console, cpu: int | Non
     with tempfile.TemporaryDirectory(prefix="ima-bench-") as tmp:
         run_dir = Path(tmp) / "run"
         where = "floating" if cpu is None else f"pinned to CPU {cpu}"
-        pin = None if cpu is None else functools.partial(os.sched_setaffinity, 0, {cpu})
         with console.status(f"flying {system.stem} {duration_s:g} s (seed {seed}, light "
                             f"turbulence), {where}{what}"):
             with cpu_sampler.Sampler() as sampler:
                 t0 = time.monotonic()
-                done = subprocess.run(_launch_cmd(system, duration_s, seed, run_dir),
-                                      capture_output=True, text=True, cwd=paths.repo_root(),
-                                      preexec_fn=pin)
+                with _pinned(cpu):
+                    proc = subprocess.Popen(_launch_cmd(system, duration_s, seed, run_dir),
+                                            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                            text=True, cwd=paths.repo_root())
+                out, err = proc.communicate()
                 wall = time.monotonic() - t0
+        done = subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
         if done.returncode != 0:
             raise ImaError(f"benchmark run failed ({done.returncode}): "
                            f"{done.stderr.strip()[-500:]}")
@@ -123,19 +140,22 @@ def fly_aggregate(system: Path, duration_s: float, seed: int, console) -> dict:
             for k, c in enumerate(cpus):
                 run_dir = Path(tmp) / f"run{k}"
                 cmd = _launch_cmd(system, duration_s, seed + k, run_dir)
-                procs.append((run_dir, subprocess.Popen(
-                    cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                    cwd=paths.repo_root(), preexec_fn=functools.partial(
-                        os.sched_setaffinity, 0, {c}))))
+                # stderr into a file: a pipe read in turn could hold a flight up
+                log = open(Path(tmp) / f"run{k}.err", "w")  # noqa: SIM115 - closed below
+                with _pinned(c):
+                    procs.append((run_dir, log, subprocess.Popen(
+                        cmd, stdout=subprocess.DEVNULL, stderr=log, cwd=paths.repo_root())))
             errors = []
-            for run_dir, p in procs:
-                _, err = p.communicate()
+            for run_dir, log, p in procs:
+                p.wait()
+                log.close()
                 if p.returncode != 0:
+                    err = Path(log.name).read_text(errors="replace")
                     errors.append(f"{run_dir.name}: exit {p.returncode}: {err.strip()[-300:]}")
             wall = time.monotonic() - t0
         if errors:
             raise ImaError("benchmark flights failed: " + "; ".join(errors))
-        flown = [_flown_s(run_dir) for run_dir, _ in procs]
+        flown = [_flown_s(run_dir) for run_dir, _, _ in procs]
     return {"flights": len(procs), "cpus": cpus, "wall_s": round(wall, 2),
             "flight_s": [round(f, 1) for f in flown],
             "aggregate_speedup": round(sum(flown) / wall, 1)}

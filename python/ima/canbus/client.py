@@ -115,9 +115,11 @@ class BusClient:
         finally:
             out.clear()
 
-    def done(self, t_ns: int) -> None:
-        """Report the quantum up to `t_ns` finished; queued frames go first, same datagram."""
-        rec = _pack(_MSG_DONE, 0, 0, 0, 0, t_ns, 0, b"")
+    def done(self, t_ns: int, need_ns: int = 0) -> None:
+        """Report the quantum up to `t_ns` finished; queued frames go first, same datagram.
+        need_ns > t_ns: nothing to do before it, the bus grants no quantum ending at or before
+        it (proto.h)."""
+        rec = _pack(_MSG_DONE, 0, 0, 0, 0, t_ns, need_ns if need_ns > t_ns else 0, b"")
         out = self._out
         if out and len(out) < proto.MAX_RECS:
             out.append(rec)

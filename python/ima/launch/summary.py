@@ -25,7 +25,7 @@ def parse_members(text: str) -> list[str]:
 def node_reports(run_dir: Path, node: str) -> dict[str, list[dict]]:
     """The io partition's membership changes and self-monitor reports in a node's trace."""
     membership, monitor = [], []
-    for rec in read_jsonl(run_dir / f"{node}.jsonl"):
+    for rec in read_jsonl(run_dir / f"{node}.jsonl", needle="app_message"):
         if rec.get("kind") != "app_message":
             continue
         text = rec.get("text", "")

@@ -104,6 +104,17 @@ static int fly(mm_t *mm, ac_t *a, world_t *w, const image_t *plan, double second
     return out;
 }
 
+/* A fresh mission manager and aircraft in a nominal world (the link up, GPS, the flight
+ * control in MISSION, the plan agreed), given the plan and flown `seconds`. */
+static void start(mm_t *mm, ac_t *a, world_t *w, const image_t *im, double seconds,
+                  rpas_mm_status_msg_t *st)
+{
+    mm_init(mm, NULL);
+    ac_init(a);
+    *w = (world_t){.c2_up = true, .gps_ok = true, .fcs_mission = true, .agreed_crc = image_crc(im)};
+    fly(mm, a, w, im, seconds, st);
+}
+
 /* ---- tests -------------------------------------------------------------------------------- */
 
 static void test_crc32(void)
@@ -210,12 +221,10 @@ static void test_square_mission(void)
     image_t im;
     square(&im);
     mm_t mm;
-    mm_init(&mm, NULL);
     ac_t a;
-    ac_init(&a);
-    world_t w = {.c2_up = true, .gps_ok = true, .fcs_mission = true, .agreed_crc = image_crc(&im)};
+    world_t w;
     rpas_mm_status_msg_t st;
-    fly(&mm, &a, &w, &im, 1.0, &st);
+    start(&mm, &a, &w, &im, 1.0, &st);
     CHECK(st.state == RPAS_MM_ACTIVE && st.leg == 1 && st.leg_type == RPAS_LEG_TF);
     CHECK(st.plan_id == 42 && st.plan_crc == image_crc(&im));
     double worst = 0.0;
@@ -278,12 +287,10 @@ static void test_altitude_terminators(void)
     va->alt_ft = 3000.0f;
     im.h.n_mission_legs = im.h.n_legs;
     mm_t mm;
-    mm_init(&mm, NULL);
     ac_t a;
-    ac_init(&a);
-    world_t w = {.c2_up = true, .gps_ok = true, .fcs_mission = true, .agreed_crc = image_crc(&im)};
+    world_t w;
     rpas_mm_status_msg_t st;
-    fly(&mm, &a, &w, &im, 0.1, &st);
+    start(&mm, &a, &w, &im, 0.1, &st);
     CHECK(st.leg == 1);
     int k = 0;
     while (st.leg == 1 && k++ < 20 * 300)
@@ -309,12 +316,10 @@ static void test_hold_circuits(void)
     hm->flags = RPAS_LEG_TURN_RIGHT;
     im.h.n_mission_legs = im.h.n_legs;
     mm_t mm;
-    mm_init(&mm, NULL);
     ac_t a;
-    ac_init(&a);
-    world_t w = {.c2_up = true, .gps_ok = true, .fcs_mission = true, .agreed_crc = image_crc(&im)};
+    world_t w;
     rpas_mm_status_msg_t st;
-    fly(&mm, &a, &w, &im, 0.1, &st);
+    start(&mm, &a, &w, &im, 0.1, &st);
     int k = 0;
     while (st.leg != 2 && k++ < 20 * 200)
         fly(&mm, &a, &w, NULL, 0.05, &st);
@@ -343,13 +348,11 @@ static void test_c2_loss_procedure_and_resume(void)
         .action = RPAS_CTA_PROCEDURE, .resume = 1, .first_leg = 4, .n_legs = 2,
         .detect_s = 2.0f, .continue_s = 10.0f};
     mm_t mm;
-    mm_init(&mm, NULL);
     ac_t a;
-    ac_init(&a);
-    world_t w = {.c2_up = true, .gps_ok = true, .fcs_mission = true, .agreed_crc = image_crc(&im)};
+    world_t w;
     rpas_mm_status_msg_t st;
     rpas_mission_msg_t m;
-    fly(&mm, &a, &w, &im, 20.0, &st);
+    start(&mm, &a, &w, &im, 20.0, &st);
     CHECK(st.leg == 1);
     w.c2_up = false;
     int64_t lost = a.t;
@@ -394,12 +397,10 @@ static void test_nested_contingencies(void)
     im.h.contingency[RPAS_CT_C2_LOSS] = (rpas_plan_contingency_t){
         .action = RPAS_CTA_PROCEDURE, .resume = 1, .first_leg = 5, .n_legs = 1, .detect_s = 1.0f};
     mm_t mm;
-    mm_init(&mm, NULL);
     ac_t a;
-    ac_init(&a);
-    world_t w = {.c2_up = true, .gps_ok = true, .fcs_mission = true, .agreed_crc = image_crc(&im)};
+    world_t w;
     rpas_mm_status_msg_t st;
-    fly(&mm, &a, &w, &im, 10.0, &st);
+    start(&mm, &a, &w, &im, 10.0, &st);
     CHECK(st.leg == 1);
     w.fcs_mode = RPAS_MODE_DIRECT;
     fly(&mm, &a, &w, NULL, 3.0, &st);
@@ -426,12 +427,10 @@ static void test_gps_loss_hold_and_termination(void)
     im.h.contingency[RPAS_CT_TERMINATION] = (rpas_plan_contingency_t){
         .action = RPAS_CTA_TERMINATE, .detect_s = 0.5f};
     mm_t mm;
-    mm_init(&mm, NULL);
     ac_t a;
-    ac_init(&a);
-    world_t w = {.c2_up = true, .gps_ok = true, .fcs_mission = true, .agreed_crc = image_crc(&im)};
+    world_t w;
     rpas_mm_status_msg_t st;
-    fly(&mm, &a, &w, &im, 10.0, &st);
+    start(&mm, &a, &w, &im, 10.0, &st);
     w.gps_ok = false;
     fly(&mm, &a, &w, NULL, 1.1, &st);
     CHECK(st.state == RPAS_MM_CONTINGENCY && st.contingency == RPAS_CT_GPS_LOSS);
@@ -464,12 +463,10 @@ static void test_traffic_avoidance(void)
     im.h.contingency[RPAS_CT_TRAFFIC] = (rpas_plan_contingency_t){
         .action = RPAS_CTA_AVOID, .resume = 1, .detect_s = 0.5f, .p1 = 60.0f, .p2 = 500.0f};
     mm_t mm;
-    mm_init(&mm, NULL);
     ac_t a;
-    ac_init(&a);
-    world_t w = {.c2_up = true, .gps_ok = true, .fcs_mission = true, .agreed_crc = image_crc(&im)};
+    world_t w;
     rpas_mm_status_msg_t st;
-    fly(&mm, &a, &w, &im, 10.0, &st);
+    start(&mm, &a, &w, &im, 10.0, &st);
     double trk0 = a.trk;
     w.traffic = true; /* intruder ahead on the left (north-east), 100 ft below */
     fly(&mm, &a, &w, NULL, 0.6, &st);
@@ -487,12 +484,10 @@ static void test_pilot_commands(void)
     image_t im;
     square(&im);
     mm_t mm;
-    mm_init(&mm, NULL);
     ac_t a;
-    ac_init(&a);
-    world_t w = {.c2_up = true, .gps_ok = true, .fcs_mission = true, .agreed_crc = image_crc(&im)};
+    world_t w;
     rpas_mm_status_msg_t st;
-    fly(&mm, &a, &w, &im, 5.0, &st);
+    start(&mm, &a, &w, &im, 5.0, &st);
     w.cmd_seq = 1, w.cmd = RPAS_MMC_PAUSE;
     fly(&mm, &a, &w, NULL, 60.0, &st);
     CHECK(st.state == RPAS_MM_PAUSED);

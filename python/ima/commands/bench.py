@@ -9,6 +9,17 @@ from pathlib import Path
 from ima.commands.run import positive_int
 
 
+def _target(targets, name: str, help_: str, duration: int | None = None,
+            duration_help: str = "") -> argparse.ArgumentParser:
+    """A benchmark's subcommand: --json, and --duration SECONDS when it flies."""
+    p = targets.add_parser(name, help=help_)
+    p.add_argument("--json", action="store_true", help="print the results as JSON")
+    if duration is not None:
+        p.add_argument("--duration", type=positive_int, default=duration, metavar="SECONDS",
+                       help=f"{duration_help} (default {duration})")
+    return p
+
+
 def add_parser(subparsers) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         "bench",
@@ -17,53 +28,39 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "never asserted in timed tests.",
     )
     targets = parser.add_subparsers(dest="target", metavar="TARGET", required=True)
-    ske = targets.add_parser(
-        "ske", help="separation kernel emulator: schedule speed, window switch time, jitter"
-    )
-    ske.add_argument("--json", action="store_true", help="print the results as JSON")
+    ske = _target(targets, "ske", "separation kernel emulator: schedule speed, window switch "
+                  "time (floating and pinned to one CPU), jitter")
     ske.add_argument(
         "--frames",
         type=positive_int,
         metavar="N",
         help="major frames per measurement (default: the benchmark's own)",
     )
-    fl = targets.add_parser(
-        "flight", help="flight loop: speed-up of a 10-minute flight, CAN bus frames/s, peak memory"
-    )
-    fl.add_argument("--json", action="store_true", help="print the results as JSON")
-    fl.add_argument("--duration", type=positive_int, default=600, metavar="SECONDS",
-                    help="emulated flight time (default 600)")
-    tri = targets.add_parser(
-        "triplex", help="the triplex system: speed-up of a 10-minute flight of 3 nodes, "
-        "node-to-node DDS latency next to ddsperf's, peak memory")
-    tri.add_argument("--json", action="store_true", help="print the results as JSON")
-    tri.add_argument("--duration", type=positive_int, default=600, metavar="SECONDS",
-                     help="emulated flight time (default 600)")
+    _target(targets, "flight", "flight loop: speed-up of a 10-minute ima launch of one node "
+            "(floating, pinned to one CPU, one flight per CPU), CPU by process kind, the floor, "
+            "CAN bus frames/s, peak memory", 600, "emulated flight time")
+    tri = _target(targets, "triplex", "the triplex system: speed-up of a 10-minute ima launch "
+                  "of 3 nodes (floating, pinned, one flight per CPU), CPU by process kind, the "
+                  "floor, node-to-node DDS latency next to ddsperf's, peak memory", 600,
+                  "emulated flight time")
     tri.add_argument("--dds-security", choices=("auth", "sign", "encrypt"), default="sign",
                      metavar="MODE", help="the DDS Security mode the secure latency is measured "
                      "in: auth, sign (the default, as runs have it) or encrypt")
-    camp = targets.add_parser(
-        "campaign", help="the campaign runner: runs per hour of 60 s and 300 s triplex "
-        "flights at -j 1 and -j 2, parallel efficiency, runner overhead, peak memory")
-    camp.add_argument("--json", action="store_true", help="print the results as JSON")
+    camp = _target(targets, "campaign", "the campaign runner: runs per hour of 60 s and 300 s "
+                   "triplex flights at -j 1 and -j 2, parallel efficiency, runner overhead, peak "
+                   "memory")
     camp.add_argument("--runs-60", type=positive_int, default=8, metavar="N",
                       help="runs of 60 s flights per measurement (default 8)")
     camp.add_argument("--runs-300", type=positive_int, default=6, metavar="N",
                       help="runs of 300 s flights per measurement (default 6)")
-    tr = targets.add_parser(
-        "trace", help="the recording's cost on a triplex run, ima trace stats on 10-minute and "
-        "1-hour recordings, against python-can's readers")
-    tr.add_argument("--json", action="store_true", help="print the results as JSON")
-    tr.add_argument("--duration", type=positive_int, default=120, metavar="SECONDS",
-                    help="the flights timed with and without recording (default 120)")
+    tr = _target(targets, "trace", "the recording's cost on a triplex run, ima trace stats on "
+                 "10-minute and 1-hour recordings, against python-can's readers", 120,
+                 "the flights timed with and without recording")
     tr.add_argument("--pairs", type=positive_int, default=3, metavar="N",
                     help="alternating pairs of flights (default 3)")
-    mis = targets.add_parser(
-        "mission", help="the mission manager: its CPU time per cycle (median, p99, max) "
-        "against its window, and the speed-up of a one-hour mission in the triplex")
-    mis.add_argument("--json", action="store_true", help="print the results as JSON")
-    mis.add_argument("--duration", type=positive_int, default=3600, metavar="SECONDS",
-                     help="the triplex mission's emulated time (default 3600)")
+    _target(targets, "mission", "the mission manager: its CPU time per cycle (median, p99, "
+            "max) against its window, and the speed-up of a one-hour mission in the triplex",
+            3600, "the triplex mission's emulated time")
     cmp_ = targets.add_parser(
         "compare", help="a benchmark of this checkout against another checkout (the previous "
         "main), alternating, pinned to one CPU; per-pair ratios and their median")

@@ -88,8 +88,8 @@ typedef struct {
     bool dead;           /* latched */
     bool deadline_missed;/* a NodeHealth deadline miss traced, no sample since */
     int64_t last_rx_ns;  /* CLOCK_MONOTONIC of its latest sample taken, any topic */
-    bool health_seen;    /* a NodeHealth of it has come */
-    uint32_t health_own_frame; /* this node's latest frame when it came */
+    bool heard;          /* a sample of it has come, any topic */
+    uint32_t heard_own_frame; /* this node's latest frame when the last one came */
     int64_t lost_wall_ns;
     uint64_t deadline_misses;
 } agent_peer_t;
@@ -195,6 +195,7 @@ struct agent {
     uint64_t agreed, waits, timeouts, superseded, bad_datagrams, partial;
     uint64_t refused_samples;  /* from writers that are not the node of the sample's key */
     uint64_t deadline_paused;  /* lockstep: deadline misses while this node was paused too */
+    uint64_t deadline_covered; /* health deadlines missed by a node heard from within them */
     agent_lat_t xch_lat;       /* io's request to its AGREED */
     agent_lat_t dds_lat;       /* a peer's dds_write of its inputs to their take here */
     bool ready;                /* discovery is over: the DDS latency is measured from here on */

@@ -391,13 +391,18 @@ static void handle_deadline(agent_t *a, const agent_ev_t *ev)
     if (k < 1 || k > a->o.nodes || k == a->o.node)
         return;
     agent_peer_t *p = &a->peer[k - 1];
+    /* A node's io gives its health when it changes and once a second, its inputs every
+     * frame: the node missed the deadline only if nothing at all came from it within it. */
+    if (p->heard && agent_mono_ns() - p->last_rx_ns < a->o.deadline_ns) {
+        a->deadline_covered++;
+        return;
+    }
     /* In lockstep, the deadline (wall time) says something of the peer only while this node
      * flies: when its io waits for a frame's agreement, or has asked for two frames or more
-     * since the peer's last health. Otherwise the whole system is paused (the bus stopped at
-     * the end of the run, the host stalled), not the peer. */
+     * since the peer was last heard. Otherwise the whole system is paused (the bus stopped
+     * at the end of the run, the host stalled), not the peer. */
     if (!a->o.realtime && !a->pending &&
-        (!a->have_frame || !p->health_seen ||
-         (int32_t)(a->pend_frame - p->health_own_frame) < 2)) {
+        (!a->have_frame || !p->heard || (int32_t)(a->pend_frame - p->heard_own_frame) < 2)) {
         a->deadline_paused++;
         return;
     }
@@ -559,6 +564,8 @@ static void take_topic(agent_t *a, int t)
             }
             a->ts[t].read++;
             a->peer[k - 1].last_rx_ns = agent_mono_ns();
+            a->peer[k - 1].heard = true;
+            a->peer[k - 1].heard_own_frame = a->pend_frame;
             if (t == T_INPUTS) {
                 /* Cyclone stamps the sample in dds_write with the writer's clock, this
                  * machine's as well: the one-way latency of DDS between the two nodes. Not
@@ -577,9 +584,7 @@ static void take_topic(agent_t *a, int t)
                 } else
                     agree_store(&a->agree, k, buf[i].in.frame, buf[i].in.t_ns, &x);
             } else if (t == T_HEALTH) {
-                a->peer[k - 1].deadline_missed = false;
-                a->peer[k - 1].health_seen = true;
-                a->peer[k - 1].health_own_frame = a->pend_frame;
+                a->peer[k - 1].deadline_missed = false; /* the episode is over */
             }
         }
     }

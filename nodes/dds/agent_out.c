@@ -216,8 +216,10 @@ int agent_write_stats(agent_t *a)
             a->bad_datagrams, a->io_connections, a->io_disconnects, a->ev_dropped,
             a->bound_sockets);
     fprintf(f, "\"withheld\":%" PRIu64 ",\"published_late\":%" PRIu64 ",\"lost_marks\":%" PRIu64
-               ",\"deadline_paused\":%" PRIu64 ",\"faults\":[",
-            a->withheld, a->published_late, a->agree.lost, a->deadline_paused);
+               ",\"deadline_paused\":%" PRIu64 ",\"deadline_covered\":%" PRIu64
+               ",\"faults\":[",
+            a->withheld, a->published_late, a->agree.lost, a->deadline_paused,
+            a->deadline_covered);
     for (size_t i = 0; i < a->faults.n; i++)
         fprintf(f, "%s{\"fid\":\"%s\",\"class\":\"%s\",\"frames\":%" PRIu64 "}", i ? "," : "",
                 a->faults.f[i].spec.fid, dds_fault_class(&a->faults.f[i]),

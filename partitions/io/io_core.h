@@ -192,7 +192,15 @@ typedef struct {
     struct xch_mission last_mission;
     uint32_t last_mission_frame;
     bool mission_sent;
+    struct xch_health last_health; /* the health last given to the DDS agent */
+    uint32_t last_health_frame;
+    bool health_sent; /* false: the next health goes out whatever it says (a new agent) */
 } io_red_t;
+
+/* A node's health goes to DDS when it changes, and at least every this many frames (1 s):
+ * the other nodes watch the node through its inputs, every frame, and its health together
+ * (nodes/dds/agent_dds.c, handle_deadline). */
+#define IO_HEALTH_REFRESH_FRAMES 20
 
 /* 0, or -1 if the voters refuse the settings. */
 int io_red_init(io_red_t *red, const io_settings_t *s);
@@ -215,6 +223,9 @@ void io_inputs(const io_rx_t *rx, struct xch_inputs *in);
 void io_apply_agreed(io_red_t *red, io_rx_t *rx, const struct xch_agreed *ag, int64_t now);
 /* This node's health for DDS. */
 void io_health(const io_red_t *red, uint32_t fcs_mode, struct xch_health *h);
+/* True if health h is due for DDS at `frame`: it differs from the last one given, or that
+ * one is IO_HEALTH_REFRESH_FRAMES old, or none was given since health_sent was cleared. */
+bool io_health_due(io_red_t *red, const struct xch_health *h, uint32_t frame);
 /* Mission data for DDS when the pilot's targets change, and once a second: true if due. */
 bool io_mission_due(io_red_t *red, const rpas_pilot_msg_t *pilot, uint32_t frame,
                     struct xch_mission *out);

@@ -84,6 +84,7 @@ static void xch_down(void)
 {
     xch_client_close(&io.xch);
     io.xch_up = false;
+    io.red.health_sent = false; /* a new agent hears the node's health at once */
 }
 
 static void xch_send(uint16_t type, int64_t t, const void *p, size_t len)
@@ -183,7 +184,8 @@ static void exchange_inputs(int64_t t)
     report_refused_stamps();
     struct xch_health h;
     io_health(&io.red, io.last_fcs_mode, &h);
-    xch_send(XCH_HEALTH, t, &h, sizeof h);
+    if (io_health_due(&io.red, &h, io.frame_no))
+        xch_send(XCH_HEALTH, t, &h, sizeof h);
 }
 
 /* The mission plan: a plan that came whole goes to the mission manager (its CRC, its

@@ -101,6 +101,17 @@ void io_health(const io_red_t *red, uint32_t fcs_mode, struct xch_health *h)
     h->flags = red->own_voted_out ? XCH_HEALTH_DISAGREE : 0;
 }
 
+bool io_health_due(io_red_t *red, const struct xch_health *h, uint32_t frame)
+{
+    if (red->health_sent && !memcmp(h, &red->last_health, sizeof *h) &&
+        frame - red->last_health_frame < IO_HEALTH_REFRESH_FRAMES)
+        return false;
+    red->last_health = *h;
+    red->last_health_frame = frame;
+    red->health_sent = true;
+    return true;
+}
+
 void io_node_list(uint32_t mask, unsigned n_nodes, char *buf, size_t len)
 {
     size_t at = 0;

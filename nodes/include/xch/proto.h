@@ -15,7 +15,8 @@
  *              struct xch_inputs: the sensor samples this node holds. hdr.frame = major frame
  *              number (t / 50 ms), hdr.t_ns = the frame start. The agent publishes it on
  *              topic "rpas_CrossChannelInputs" and answers with one AGREED for that frame.
- *   HEALTH     once per major frame, payload struct xch_health -> topic "rpas_NodeHealth"
+ *   HEALTH     when it changes and at least once a second (io_health_due), payload struct
+ *              xch_health -> topic "rpas_NodeHealth"
  *              (deadline and liveliness QoS: how the other nodes see this one on DDS).
  *   TELEMETRY  once per major frame (io's tx process), struct xch_telemetry -> "rpas_Telemetry".
  *   MISSION    when the mission/pilot targets change, struct xch_mission -> "rpas_MissionData".

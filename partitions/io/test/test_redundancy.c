@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Unit tests of io's redundancy: membership from heartbeats (lost after the configured misses,
  * latched), the self-monitor (own command voted out after `persist` miscompares; a peer's too),
- * and the input agreement (newest sample, values voted over the members that hold it, never
- * older than what the ports hold). */
+ * the input agreement (newest sample, values voted over the members that hold it, never
+ * older than what the ports hold), and when mission data and health go to DDS. */
 #include <string.h>
 
 #include "io_core.h"
@@ -226,6 +226,27 @@ static void test_mission_due(void)
     CHECK(io_mission_due(&r, &p, 22, &m) && m.hdg_deg == 91); /* changed */
 }
 
+static void test_health_due(void)
+{
+    io_settings_t s = settings(0, 7, 2, 3);
+    io_red_t r;
+    io_red_init(&r, &s);
+    struct xch_health h;
+    io_health(&r, 2, &h);
+    CHECK(io_health_due(&r, &h, 5));  /* the first one */
+    CHECK(!io_health_due(&r, &h, 6)); /* unchanged */
+    CHECK(!io_health_due(&r, &h, 5 + IO_HEALTH_REFRESH_FRAMES - 1));
+    CHECK(io_health_due(&r, &h, 5 + IO_HEALTH_REFRESH_FRAMES)); /* once a second */
+    r.members = 3;                                              /* node3 lost */
+    io_health(&r, 2, &h);
+    CHECK(io_health_due(&r, &h, 26) && h.membership == 3); /* changed: at once */
+    io_health(&r, 3, &h);
+    CHECK(io_health_due(&r, &h, 27)); /* the flight-control mode changed */
+    r.health_sent = false;            /* a new agent */
+    CHECK(io_health_due(&r, &h, 28));
+    CHECK(!io_health_due(&r, &h, 29));
+}
+
 int main(void)
 {
     RUN(test_membership);
@@ -234,5 +255,6 @@ int main(void)
     RUN(test_agreement_time_bounds);
     RUN(test_inputs);
     RUN(test_mission_due);
+    RUN(test_health_due);
     return UNIT_RESULT();
 }

@@ -13,7 +13,7 @@ from ima.errors import ImaError
 
 from .config import VotingParams
 
-TEST_SWITCHES = ("no-vote-out",)
+TEST_SWITCHES = ("no-vote-out", "every-quantum")
 
 
 def _fault_classes() -> str:
@@ -62,7 +62,9 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--test-switch", action="append", default=[], choices=TEST_SWITCHES,
                     metavar="NAME",
                     help="TEST ONLY: no-vote-out makes the actuators' voter never vote a "
-                    "channel out (to show that a campaign oracle can fail)")
+                    "channel out (to show that a campaign oracle can fail); every-quantum makes "
+                    "the world ask for every quantum of the bus, not only those a task of it "
+                    "falls in (to show that the quanta it skips change nothing)")
     ap.add_argument("--uplink", action="append", default=[], metavar="T:FILE",
                     help="uplink the mission plan image FILE (`ima mission` compiles one) over "
                     "the C2 link at T seconds; repeatable (a later plan replaces the earlier)")

@@ -45,6 +45,14 @@ _NAV_DATA = {MESSAGES[f"NAV_DATA_{c}"].frame_id: (i, MESSAGES[f"NAV_DATA_{c}"].d
 _BRAKE_CMD = {MESSAGES[f"BRAKE_CMD_{c}"].frame_id: (i, MESSAGES[f"BRAKE_CMD_{c}"].decode)
               for i, c in enumerate(CHANNELS)}
 NEAR_GROUND_FT = 15.0  # below this height (of the centre of gravity) the wheels are watched
+# The world leaves the quanta before its next task ungranted (World._delivered) only this far
+# from every limit a crash is judged by: no aircraft gets from there to a limit within the
+# 20 ms to its next task at the latest, so a crash is found in the quantum it happens in, and
+# the run stops there, as with every quantum granted.
+SKIP_MIN_AGL_FT = 100.0
+SKIP_ROLL_MARGIN_DEG = 15.0
+SKIP_CAS_MARGIN_KT = 10.0
+SKIP_LOAD_MARGIN_G = 1.0
 FCS_MODES = choices("FCS_STATUS_A", "FCS_MODE_A")
 FCS_FALLBACKS = choices("FCS_STATUS_A", "FCS_FALLBACK_A")
 
@@ -68,7 +76,8 @@ class Options:
     voting: VotingParams | None = None
     faults: list[FaultSpec] = field(default_factory=list)  # --fault, in command-line order
     # Test-only switches (--test-switch): "no-vote-out" makes the voter never vote a
-    # channel out, to show that a campaign oracle can fail.
+    # channel out, to show that a campaign oracle can fail; "every-quantum" makes the world
+    # ask for every quantum (see World._delivered), to show that skipping them changes nothing.
     test_switches: tuple[str, ...] = ()
     # Mission plan images the station uplinks (--uplink T:FILE): [(t_ns, image)]
     uploads: list[tuple[int, bytes]] = field(default_factory=list)
@@ -160,6 +169,7 @@ class World:
                    start=script.start)
         self.faults = WorldFaults(opts.faults, self, params.faults) if opts.faults else None
         self._tasks = self._make_tasks()
+        self.skip_quanta = "every-quantum" not in opts.test_switches  # see _delivered()
 
     @staticmethod
     def _selector(channels: int | None, vp: VotingParams | None, params: WorldParams,
@@ -508,22 +518,69 @@ class World:
         self.crash = (self.t_now, reason)
         raise Crash(reason)
 
+    # -- skipped quanta ------------------------------------------------------------------
+    # Far from the limits of a crash, the world asks for no quantum before its next task (its
+    # DONE says when: the bus then grants it none ending at or before that instant). The
+    # frames the bus delivered at the start of the quanta it was not granted come before its
+    # next TICK; each is applied at the quantum start that delivered it (the first at or after
+    # its end on the wire), the physics advanced to that instant first: what a world granted
+    # every quantum does.
+    def _delivered(self, frames, q: int) -> None:
+        i, n = 0, len(frames)
+        while i < n:
+            d = -(-frames[i].t_ns // q) * q
+            j = i + 1
+            while j < n and -(-frames[j].t_ns // q) * q == d:
+                j += 1
+            self.advance(d)
+            self._frames(frames if i == 0 and j == n else frames[i:j])
+            i = j
+
+    def _far_from_the_limits(self) -> bool:
+        g, lim = self.ac.get, self.p.limits
+        return (g["agl"]() > SKIP_MIN_AGL_FT
+                and abs(g["phi"]()) < lim.max_roll_deg - SKIP_ROLL_MARGIN_DEG
+                and g["cas"]() < lim.max_cas_kt - SKIP_CAS_MARGIN_KT
+                and abs(g["nz"]()) < lim.max_load_g - SKIP_LOAD_MARGIN_G)  # NaN: False
+
+    def _to_the_stop(self, q: int) -> None:
+        """The bus ended the run at its stop instant after quanta the world was not granted: the
+        frames delivered before that instant are applied and the physics flown up to it, as a
+        world granted them all would have."""
+        bus = self.bus
+        stop = bus.stop_t_ns
+        if stop is None or stop <= self.t_end:
+            return
+        frames = [f for f in bus.unticked if -(-f.t_ns // q) * q < stop]
+        if frames:
+            self._delivered(frames, q)
+        self.advance(stop)
+        self.t_end = stop
+
     # -- main loop -----------------------------------------------------------------------
     def run(self) -> int:
         bus = self.bus
         tasks = self._tasks
         next_due = min(tk[0] for tk in tasks)
         next_flush = FLUSH_EVERY_NS
+        # the quantum of a bus that grants only the quanta asked for (ima-canbus; not the
+        # unit tests' in-process stand-in): 0, every quantum
+        q = getattr(bus, "quantum_ns", 0) if self.skip_quanta else 0
         wall0 = time.perf_counter()
         try:
             while True:
                 tick = bus.wait_tick()
                 if tick is None:
                     self.stop_reason = proto.STOP_REASONS.get(bus.stopped, str(bus.stopped))
+                    if q:
+                        self._to_the_stop(q)
                     break
                 T, t_until, frames = tick
                 if frames:
-                    self._frames(frames)
+                    if q:
+                        self._delivered(frames, q)
+                    else:
+                        self._frames(frames)
                 while next_due < t_until:
                     s = next_due
                     self.advance(s)
@@ -535,7 +592,10 @@ class World:
                     next_due = min(tk[0] for tk in tasks)
                 self.advance(t_until)
                 self.t_end = t_until
-                bus.done(t_until)
+                if q and self._far_from_the_limits():
+                    bus.done(t_until, next_due)
+                else:
+                    bus.done(t_until)
                 if t_until >= next_flush:
                     # a run killed outright (kill -9) loses at most this much of the traces
                     self.events_f.flush()

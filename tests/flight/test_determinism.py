@@ -1,10 +1,14 @@
 # SPDX-License-Identifier: Apache-2.0
 """Same seed, same inputs: the lockstep makes two flights byte-identical, world truth, CAN bus
-trace and node trace alike; another seed flies differently."""
+trace and node trace alike; another seed flies differently. The quanta the world skips (it asks
+for those its tasks fall in) change nothing: a world granted every quantum flies the same."""
 
 from __future__ import annotations
 
+import json
+
 import pytest
+from flight_helpers import fault
 
 FILES = ("truth.jsonl", "can.jsonl", "node1.jsonl", "world.jsonl")
 
@@ -14,6 +18,18 @@ def runs(flights):
     kw = dict(duration_s=60.0, turbulence="light", wind_kt=10)
     return (flights.fly("det_a", seed=11, **kw), flights.fly("det_b", seed=11, **kw),
             flights.fly("det_c", seed=12, **kw))
+
+
+@pytest.fixture(scope="module")
+def every_quantum(flights):
+    return flights.fly("det_every_quantum", seed=11, duration_s=60.0, turbulence="light",
+                       wind_kt=10, test_switches=["world:every-quantum"])
+
+
+def _world_ticks(run) -> dict:
+    (world,) = [c for c in json.loads((run.run_dir / "canbus.json").read_text())["clients"]
+                if c["name"] == "world"]
+    return world
 
 
 @pytest.mark.parametrize("name", FILES)
@@ -26,6 +42,28 @@ def test_same_seed_identical_traces(runs, name):
         la, lb = da.splitlines(), db.splitlines()
         first = next(i for i, (x, y) in enumerate(zip(la, lb)) if x != y) if la[:len(lb)] != lb[:len(la)] else min(len(la), len(lb))
         pytest.fail(f"{name} differs first at line {first + 1}:\n{la[first:first+1]}\n{lb[first:first+1]}")
+
+
+@pytest.mark.parametrize("name", FILES)
+def test_skipped_quanta_change_nothing(runs, every_quantum, name):
+    a = runs[0]
+    assert (a.run_dir / name).read_bytes() == (every_quantum.run_dir / name).read_bytes(), name
+    skipping, every = _world_ticks(a), _world_ticks(every_quantum)
+    assert every["ticks_skipped"] == 0 and skipping["ticks_skipped"] > 0.3 * every["ticks"]
+    assert skipping["ticks"] + skipping["ticks_skipped"] == every["ticks"]
+
+
+def test_a_crash_stops_the_run_in_its_quantum_either_way(flights):
+    """Near the limits a crash is judged by, the world asks for every quantum: the run stops in
+    the quantum of the crash whether it skips quanta elsewhere or not."""
+    kw = dict(duration_s=30.0, seed=11, judge=False,
+              faults=[fault("world:actuator_hardover@5:surface=elev,value=1", "hard")])
+    a = flights.fly("det_crash", **kw)
+    b = flights.fly("det_crash_every_quantum", test_switches=["world:every-quantum"], **kw)
+    assert a.summary["crashed"], a.summary
+    for name in FILES:
+        assert (a.run_dir / name).read_bytes() == (b.run_dir / name).read_bytes(), name
+    assert _world_ticks(a)["ticks_skipped"] > 0
 
 
 def test_other_seed_differs(runs):

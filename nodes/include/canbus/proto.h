@@ -43,7 +43,10 @@
  *   TICK with t_ns > s; before a window starting at or after the granted time it sends DONE
  *   with aux = s: the bus grants it no quantum [T, T+Q) with T+Q <= s (it counts as done
  *   in those), so a node is woken only for the quanta in which a window of it starts. The
- *   quanta, the frames' delivery and the wire are the same for every client either way.
+ *   world does the same with its next task's instant. A CAN client granted no quantum still
+ *   gets the frames delivered at its start, before its next TICK (the first quantum start at
+ *   or after a frame's end on the wire is the one that delivered it). The quanta, the
+ *   frames' delivery and the wire are the same for every client either way.
  *
  * Real time (--realtime on the bus): the same exchange, but the bus sends the TICK for [T, T+Q)
  * no earlier than epoch + T on CLOCK_MONOTONIC.
@@ -105,7 +108,7 @@ enum canbus_rec_type {
                              wall clock (int64 ns, little-endian), else zeros */
     CANBUS_MSG_DONE = 3,  /* LOCKSTEP client -> bus: finished everything before t_ns; aux > t_ns:
                              nothing to do before aux (no TICK wanted up to it), else 0 */
-    CANBUS_MSG_STOP = 4,  /* bus -> client: the run ends; id = CANBUS_STOP_* reason. LOCKSTEP
+    CANBUS_MSG_STOP = 4,  /* bus -> client: the run ends at t_ns; id = CANBUS_STOP_* reason. LOCKSTEP
                              client or control channel -> bus: end the run */
     CANBUS_MSG_ERROR = 5, /* bus -> CAN clients: an error frame on the wire (id = the frame's
                              identifier, t_ns = when, data[0] = sender, data[1] = its state) */

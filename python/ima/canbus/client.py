@@ -54,7 +54,8 @@ class BusClient:
 
     Frames queued with `send()` go out in one datagram with the next `done()` (or `flush()`),
     so a lockstep client costs the bus one datagram per quantum. `stopped` holds the STOP
-    reason once the bus has ended the run (or None).
+    reason once the bus has ended the run (or None), `stop_t_ns` the instant it ended it at,
+    and `unticked` the frames delivered after the last TICK, before the STOP.
     """
 
     def __init__(self, path: str, name: str, roles: int, node: int = 0,
@@ -63,6 +64,8 @@ class BusClient:
         self.name = name
         self.roles = roles
         self.stopped: int | None = None
+        self.stop_t_ns: int | None = None
+        self.unticked: list[Frame] = []
         self.errors: list[proto.Rec] = []  # ERROR records seen (bus error frames)
         self._out: list[bytes] = []
         self._pending: list[proto.Rec] = []
@@ -182,6 +185,7 @@ class BusClient:
                     break
             elif t == _MSG_STOP:
                 self.stopped = r.id
+                self.stop_t_ns = r.t_ns
                 i = len(pending)
                 break
             elif t == _MSG_ERROR:
@@ -222,6 +226,7 @@ class BusClient:
             if tick is not None:
                 return Tick(tick.aux, tick.t_ns, frames)
             if self.stopped is not None:
+                self.unticked = frames
                 return None
             if not self._read(timeout):
                 return None

@@ -92,8 +92,14 @@ class Sampler:
             st = _stat(pid)
             if st is None:
                 continue
-            # classified anew each time: a process just forked still has its parent's name
-            self._ticks[(pid, st[2])] = (_kind(pid, st[0]), st[1])
+            # classified anew each time: a process just forked still has its parent's name;
+            # but one that has ended (a zombie: no command line left) keeps its kind
+            key = (pid, st[2])
+            kind = _kind(pid, st[0])
+            prev = self._ticks.get(key)
+            if kind == "other" and prev is not None:
+                kind = prev[0]
+            self._ticks[key] = (kind, st[1])
             try:
                 with open(f"/proc/{pid}/statm") as f:
                     rss += int(f.read().split()[1]) * _PAGE

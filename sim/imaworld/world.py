@@ -46,9 +46,11 @@ _BRAKE_CMD = {MESSAGES[f"BRAKE_CMD_{c}"].frame_id: (i, MESSAGES[f"BRAKE_CMD_{c}"
               for i, c in enumerate(CHANNELS)}
 NEAR_GROUND_FT = 15.0  # below this height (of the centre of gravity) the wheels are watched
 # The world leaves the quanta before its next task ungranted (World._delivered) only this far
-# from every limit a crash is judged by: no aircraft gets from there to a limit within the
-# 20 ms to its next task at the latest, so a crash is found in the quantum it happens in, and
-# the run stops there, as with every quantum granted.
+# from every limit a crash is judged by, and for SKIP_MAX_NS at most: no aircraft gets from
+# there to a limit within that time, so a crash is found in the quantum it happens in, and the
+# run stops there, as with every quantum granted. (Should one be found later all the same,
+# its event says by how much: found_late_ns.)
+SKIP_MAX_NS = 20_000_000
 SKIP_MIN_AGL_FT = 100.0
 SKIP_ROLL_MARGIN_DEG = 15.0
 SKIP_CAS_MARGIN_KT = 10.0
@@ -170,6 +172,7 @@ class World:
         self.faults = WorldFaults(opts.faults, self, params.faults) if opts.faults else None
         self._tasks = self._make_tasks()
         self.skip_quanta = "every-quantum" not in opts.test_switches  # see _delivered()
+        self._serving_t = 0  # the start of the quantum being served (the stop, at the end)
 
     @staticmethod
     def _selector(channels: int | None, vp: VotingParams | None, params: WorldParams,
@@ -551,6 +554,7 @@ class World:
         stop = bus.stop_t_ns
         if stop is None or stop <= self.t_end:
             return
+        self._serving_t = stop
         frames = [f for f in bus.unticked if -(-f.t_ns // q) * q < stop]
         if frames:
             self._delivered(frames, q)
@@ -576,6 +580,7 @@ class World:
                         self._to_the_stop(q)
                     break
                 T, t_until, frames = tick
+                self._serving_t = T
                 if frames:
                     if q:
                         self._delivered(frames, q)
@@ -593,7 +598,7 @@ class World:
                 self.advance(t_until)
                 self.t_end = t_until
                 if q and self._far_from_the_limits():
-                    bus.done(t_until, next_due)
+                    bus.done(t_until, min(next_due, t_until + SKIP_MAX_NS))
                 else:
                     bus.done(t_until)
                 if t_until >= next_flush:
@@ -609,7 +614,11 @@ class World:
                     break
         except Crash as c:
             t, reason = self.crash
-            self.event("world", "crash", t_ns=t, reason=reason)
+            if t <= self._serving_t:  # in a quantum it was not granted (see SKIP_MAX_NS)
+                self.event("world", "crash", t_ns=t, reason=reason,
+                           found_late_ns=self._serving_t - t)
+            else:
+                self.event("world", "crash", t_ns=t, reason=reason)
             print(f"imaworld: crash at t={t / NS:.3f} s: {reason}; stopping the bus",
                   file=sys.stderr)
             self.t_end = t

@@ -16,8 +16,8 @@ _TICK = os.sysconf("SC_CLK_TCK")
 _KINDS = {"ima-ske": "ske", "ima-canbus": "bus", "ima-dds-node": "dds_agent"}
 
 
-def _stat(pid: int) -> tuple[int, int, int] | None:
-    """(parent pid, CPU ticks, start time) of a process."""
+def _stat(pid: int) -> tuple[int, int, int, bool] | None:
+    """(parent pid, CPU ticks, start time, ended: a zombie) of a process."""
     try:
         with open(f"/proc/{pid}/stat", "rb") as f:
             stat = f.read()
@@ -25,7 +25,7 @@ def _stat(pid: int) -> tuple[int, int, int] | None:
         return None
     # the command name may hold spaces and parentheses: fields start after the last ')'
     fields = stat[stat.rindex(b")") + 2:].split()
-    return int(fields[1]), int(fields[11]) + int(fields[12]), int(fields[19])
+    return int(fields[1]), int(fields[11]) + int(fields[12]), int(fields[19]), fields[0] == b"Z"
 
 
 def _comm(pid: int) -> str:
@@ -95,10 +95,8 @@ class Sampler:
             # classified anew each time: a process just forked still has its parent's name;
             # but one that has ended (a zombie: no command line left) keeps its kind
             key = (pid, st[2])
-            kind = _kind(pid, st[0])
             prev = self._ticks.get(key)
-            if kind == "other" and prev is not None:
-                kind = prev[0]
+            kind = prev[0] if st[3] and prev is not None else _kind(pid, st[0])
             self._ticks[key] = (kind, st[1])
             try:
                 with open(f"/proc/{pid}/statm") as f:

@@ -55,7 +55,8 @@ class BusClient:
     Frames queued with `send()` go out in one datagram with the next `done()` (or `flush()`),
     so a lockstep client costs the bus one datagram per quantum. `stopped` holds the STOP
     reason once the bus has ended the run (or None), `stop_t_ns` the instant it ended it at,
-    and `unticked` the frames delivered after the last TICK, before the STOP.
+    and `unticked` the frames delivered after the last TICK, before the STOP (a bus that
+    closes the connection without a STOP leaves `stop_t_ns` None: those frames are not told).
     """
 
     def __init__(self, path: str, name: str, roles: int, node: int = 0,

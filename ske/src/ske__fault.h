@@ -51,6 +51,7 @@ typedef struct {
     int n; /* as given, for the trace */
     const char *given[SKE_MAX_SWITCHES];
     bool eat_next_window; /* overrun-eats-next-window */
+    bool every_quantum;   /* every-quantum: no window runs ahead of the bus (supervisor.c) */
     int8_t hm_action[SKE_MAX_PARTITIONS]; /* hm-action: hm_action_t per partition, -1: none */
     int n_corrupt;
     ske_corrupt_switch_t corrupt[SKE_MAX_SWITCHES];

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Test switches (ima-ske --test-switch): deliberate breaches of what the SKE otherwise
- * guarantees, used only to show that a fault campaign's oracles notice them. Each is
- * recorded at module start; none is for a flight. */
+ * guarantees, used only to show that a fault campaign's oracles notice them, and
+ * every-quantum, the lockstep's plainer way, to show that the windows run ahead of the bus
+ * change nothing. Each is recorded at module start; none is for a flight. */
 #include "ske__supervisor.h"
 
 #include <stdio.h>
@@ -39,6 +40,10 @@ int ske__switches_parse(ske_switches_t *sw, const ske_module_cfg_t *m, const cha
             if (v)
                 return bad(err, errlen, g, "overrun-eats-next-window takes no value");
             sw->eat_next_window = true;
+        } else if (nlen == strlen("every-quantum") && !strncmp(g, "every-quantum", nlen)) {
+            if (v)
+                return bad(err, errlen, g, "every-quantum takes no value");
+            sw->every_quantum = true;
         } else if (nlen == strlen("hm-action") && !strncmp(g, "hm-action", nlen)) {
             const char *colon = v ? strchr(v, ':') : NULL;
             if (!colon)
@@ -75,7 +80,8 @@ int ske__switches_parse(ske_switches_t *sw, const ske_module_cfg_t *m, const cha
             sw->n_corrupt++;
         } else {
             return bad(err, errlen, g, "unknown test switch (overrun-eats-next-window, "
-                       "hm-action=PARTITION:ACTION, corrupt-port=PARTITION.PORT@TIME)");
+                       "every-quantum, hm-action=PARTITION:ACTION, "
+                       "corrupt-port=PARTITION.PORT@TIME)");
         }
     }
     return SKE_OK;

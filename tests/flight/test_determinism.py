@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """Same seed, same inputs: the lockstep makes two flights byte-identical, world truth, CAN bus
 trace and node trace alike; another seed flies differently. The quanta the world skips (it asks
-for those its tasks fall in) change nothing: a world granted every quantum flies the same."""
+for those its tasks fall in) change nothing: a world granted every quantum flies the same; nor
+do the windows an SKE runs ahead of the bus (its partitions that are not system partitions)."""
 
 from __future__ import annotations
 
@@ -26,10 +27,26 @@ def every_quantum(flights):
                        wind_kt=10, test_switches=["world:every-quantum"])
 
 
+@pytest.fixture(scope="module")
+def ske_every_quantum(flights):
+    return flights.fly("det_ske_every_quantum", seed=11, duration_s=60.0, turbulence="light",
+                       wind_kt=10, test_switches=["ske:every-quantum"])
+
+
+def _ticks(run, client: str) -> dict:
+    (c,) = [c for c in json.loads((run.run_dir / "canbus.json").read_text())["clients"]
+            if c["name"] == client]
+    return c
+
+
 def _world_ticks(run) -> dict:
-    (world,) = [c for c in json.loads((run.run_dir / "canbus.json").read_text())["clients"]
-                if c["name"] == "world"]
-    return world
+    return _ticks(run, "world")
+
+
+def _without_switches(data: bytes) -> bytes:
+    """A node's trace without its test_switch events (the SKE records its switches)."""
+    return b"".join(line for line in data.splitlines(keepends=True)
+                    if b'"kind":"test_switch"' not in line)
 
 
 @pytest.mark.parametrize("name", FILES)
@@ -51,6 +68,17 @@ def test_skipped_quanta_change_nothing(runs, every_quantum, name):
     skipping, every = _world_ticks(a), _world_ticks(every_quantum)
     assert every["ticks_skipped"] == 0 and skipping["ticks_skipped"] > 0.3 * every["ticks"]
     assert skipping["ticks"] + skipping["ticks_skipped"] == every["ticks"]
+
+
+@pytest.mark.parametrize("name", FILES)
+def test_windows_run_ahead_change_nothing(runs, ske_every_quantum, name):
+    a, b = runs[0], ske_every_quantum
+    assert _without_switches((a.run_dir / name).read_bytes()) == \
+        _without_switches((b.run_dir / name).read_bytes()), name
+    ahead, every = _ticks(a, "node1"), _ticks(b, "node1")
+    # woken for its io windows only (2 quanta of 5), not for every window (3 of 5)
+    assert ahead["ticks"] + ahead["ticks_skipped"] == every["ticks"] + every["ticks_skipped"]
+    assert ahead["ticks"] < every["ticks"], (ahead, every)
 
 
 def test_a_crash_stops_the_run_in_its_quantum_either_way(flights):

@@ -42,8 +42,9 @@
  *   A node whose SKE is a LOCKSTEP client runs a window starting at s only once it holds a
  *   TICK with t_ns > s; before a window starting at or after the granted time it sends DONE
  *   with aux = s: the bus grants it no quantum [T, T+Q) with T+Q <= s (it counts as done
- *   in those), so a node is woken only for the quanta in which a window of it starts. The
- *   world does the same with its next task's instant. A CAN client granted no quantum still
+ *   in those), so a node is woken only for the quanta in which a window of it starts (of
+ *   a system partition: the others run ahead, ske/src/supervisor.c). The world does the
+ *   same with its next task's instant. A CAN client granted no quantum still
  *   gets the frames delivered at its start, before its next TICK (the first quantum start at
  *   or after a frame's end on the wire is the one that delivered it). The quanta, the
  *   frames' delivery and the wire are the same for every client either way.

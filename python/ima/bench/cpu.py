@@ -36,7 +36,9 @@ def _comm(pid: int) -> str:
         return ""
 
 
-def _kind(pid: int, ppid: int) -> str:
+def _kind(pid: int, ppid: int) -> str | None:
+    """The kind of a process; None when it cannot be told any more (it is ending: its command
+    line is gone)."""
     comm = _comm(pid)
     if _comm(ppid) == "ima-ske":
         return f"partition:{comm}"
@@ -47,7 +49,9 @@ def _kind(pid: int, ppid: int) -> str:
             with open(f"/proc/{pid}/cmdline", "rb") as f:
                 cmd = f.read()
         except OSError:
-            return "other"
+            return None
+        if not cmd:
+            return None
         args = cmd.split(b"\0")
         if b"imaworld" in args:
             return "world"
@@ -93,10 +97,12 @@ class Sampler:
             if st is None:
                 continue
             # classified anew each time: a process just forked still has its parent's name;
-            # but one that has ended (a zombie: no command line left) keeps its kind
+            # but one that is ending (a zombie, or no command line left) keeps its kind
             key = (pid, st[2])
             prev = self._ticks.get(key)
-            kind = prev[0] if st[3] and prev is not None else _kind(pid, st[0])
+            kind = None if st[3] else _kind(pid, st[0])
+            if kind is None:
+                kind = prev[0] if prev is not None else "other"
             self._ticks[key] = (kind, st[1])
             try:
                 with open(f"/proc/{pid}/statm") as f:

@@ -1,8 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The fast codecs agree with cantools on every message of rpas.dbc, both ways."""
+"""The fast codecs agree with cantools on every message of rpas.dbc, both ways; what cantools
+read of a DBC is kept and read back the same."""
 
 from __future__ import annotations
 
+import json
 import random
 
 import cantools
@@ -74,3 +76,35 @@ def test_roundtrip_keeps_resolution():
 
 def test_choices_come_from_the_dbc():
     assert codec.choices("FCS_STATUS_A", "FCS_MODE_A")[2] == "AUTOPILOT"
+
+
+def _layouts(messages: dict) -> dict:
+    return {n: (m.frame_id, m.extended, m.length, m.cycle_ms, m.signals)
+            for n, m in messages.items()}
+
+
+def test_the_dbc_cache_gives_the_same_codecs_and_follows_the_file(tmp_path, monkeypatch):
+    """What cantools read of a DBC is kept in the build tree by the file's content: a second
+    load reads the cache (not cantools), the same layouts; a changed file is read anew; a
+    garbled cache is read around and written again."""
+    monkeypatch.setenv("IMA_BUILD_DIR", str(tmp_path / "build"))
+    (tmp_path / "build").mkdir()
+    dbc = tmp_path / "a.dbc"
+    dbc.write_bytes(codec.DBC_PATH.read_bytes())
+    first = codec.load(dbc)
+    (cache,) = (tmp_path / "build" / "dbc-cache").iterdir()
+    assert _layouts(first) == _layouts(codec.MESSAGES)
+    calls = []
+    monkeypatch.setattr(codec, "_read_dbc", lambda p: calls.append(p) or [])
+    assert _layouts(codec.load(dbc)) == _layouts(first) and calls == []  # from the cache
+    m = first["AHRS_ATT"]
+    data = m.encode(12.5, -3.25, 271.0, 3, 7)
+    assert codec.load(dbc)["AHRS_ATT"].decode(data) == m.decode(data)
+    dbc.write_bytes(codec.DBC_PATH.read_bytes() + b"\n")  # another file: another key
+    assert codec.load(dbc) == {} and calls == [dbc]
+    monkeypatch.undo()
+    monkeypatch.setenv("IMA_BUILD_DIR", str(tmp_path / "build"))
+    cache.write_text("{not json")
+    dbc.write_bytes(codec.DBC_PATH.read_bytes())
+    assert _layouts(codec.load(dbc)) == _layouts(first)
+    assert json.loads(cache.read_text())["layout"] == codec._CACHE_LAYOUT

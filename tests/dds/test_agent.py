@@ -310,14 +310,16 @@ def test_health_deadline_is_no_miss_while_the_run_is_paused(agents, connect):
 def test_quiet_health_is_no_miss_while_the_inputs_come(agents, connect):
     """Emulated time: a node's health comes when it changes and once a second, its inputs
     every frame: a health deadline passed while the node's inputs came is no miss."""
-    ags = agents(2, extra=["--deadline-ms", "300", "--lease-ms", "60000"])
+    # a deadline well above the inputs' period (a loaded machine stalls a process for tens of
+    # milliseconds), passed some four times while node 2 waits for node 1's inputs
+    ags = agents(2, extra=["--deadline-ms", "500", "--lease-ms", "60000"])
     c1, c2 = connect(ags[0]), connect(ags[1])
     for c in (c1, c2):
         c.send(xch.HEALTH, 0, 0, xch.pack_health(membership=0b11))
     exchange_round({1: c1, 2: c2}, 0, {1: 0b11, 2: 0b11})
-    for frame in range(1, 10):  # 1.8 s, no health: node 2 waits 200 ms for node 1 each frame
+    for frame in range(1, 15):  # 2.1 s, no health: node 2 waits 150 ms for node 1 each frame
         c2.send_inputs(frame, frame * 50_000_000, inputs_for(2, frame, 0b11))
-        time.sleep(0.2)
+        time.sleep(0.15)
         c1.send_inputs(frame, frame * 50_000_000, inputs_for(1, frame, 0b11))
         c1.await_agreed(frame, 10)
         c2.await_agreed(frame, 10)
@@ -325,7 +327,7 @@ def test_quiet_health_is_no_miss_while_the_inputs_come(agents, connect):
         a.stop()
     # (the start-up's frame 0 may outlast a deadline on a loaded machine: real time is real)
     assert not [m for m in ags[1].of_kind("dds_deadline_missed") if m["t_ns"] > 0]
-    assert ags[1].read_stats()["deadline_covered"] >= 3
+    assert ags[1].read_stats()["deadline_covered"] >= 2
 
 
 def test_hung_peer_is_not_waited_for_after_a_lease(agents, connect):

@@ -528,12 +528,17 @@ class World:
     # next TICK; each is applied at the quantum start that delivered it (the first at or after
     # its end on the wire), the physics advanced to that instant first: what a world granted
     # every quantum does.
+    @staticmethod
+    def _delivery(frame, q: int) -> int:
+        """The quantum start that delivered a frame: the first at or after its end on the wire."""
+        return -(-frame.t_ns // q) * q
+
     def _delivered(self, frames, q: int) -> None:
         i, n = 0, len(frames)
         while i < n:
-            d = -(-frames[i].t_ns // q) * q
+            d = self._delivery(frames[i], q)
             j = i + 1
-            while j < n and -(-frames[j].t_ns // q) * q == d:
+            while j < n and self._delivery(frames[j], q) == d:
                 j += 1
             self.advance(d)
             self._frames(frames if i == 0 and j == n else frames[i:j])
@@ -555,7 +560,7 @@ class World:
         if stop is None or stop <= self.t_end:
             return
         self._serving_t = stop
-        frames = [f for f in bus.unticked if -(-f.t_ns // q) * q < stop]
+        frames = [f for f in bus.unticked if self._delivery(f, q) < stop]
         if frames:
             self._delivered(frames, q)
         self.advance(stop)

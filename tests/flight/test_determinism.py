@@ -39,10 +39,6 @@ def _ticks(run, client: str) -> dict:
     return c
 
 
-def _world_ticks(run) -> dict:
-    return _ticks(run, "world")
-
-
 def _without_switches(data: bytes) -> bytes:
     """A node's trace without its test_switch events (the SKE records its switches)."""
     return b"".join(line for line in data.splitlines(keepends=True)
@@ -65,7 +61,7 @@ def test_same_seed_identical_traces(runs, name):
 def test_skipped_quanta_change_nothing(runs, every_quantum, name):
     a = runs[0]
     assert (a.run_dir / name).read_bytes() == (every_quantum.run_dir / name).read_bytes(), name
-    skipping, every = _world_ticks(a), _world_ticks(every_quantum)
+    skipping, every = _ticks(a, "world"), _ticks(every_quantum, "world")
     assert every["ticks_skipped"] == 0 and skipping["ticks_skipped"] > 0.3 * every["ticks"]
     assert skipping["ticks"] + skipping["ticks_skipped"] == every["ticks"]
 
@@ -91,7 +87,7 @@ def test_a_crash_stops_the_run_in_its_quantum_either_way(flights):
     assert a.summary["crashed"], a.summary
     for name in FILES:
         assert (a.run_dir / name).read_bytes() == (b.run_dir / name).read_bytes(), name
-    assert _world_ticks(a)["ticks_skipped"] > 0
+    assert _ticks(a, "world")["ticks_skipped"] > 0
 
 
 def test_other_seed_differs(runs):

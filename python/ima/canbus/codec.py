@@ -15,17 +15,17 @@ the range's end. Decoding returns physical values as floats (ints for scale-1 si
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import os
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 
 DBC_PATH = Path(__file__).resolve().parents[3] / "config" / "can" / "rpas.dbc"
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class SignalInfo:
     name: str
     start: int
@@ -38,7 +38,7 @@ class SignalInfo:
     choices: dict[int, str]
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class MessageCodec:
     """One message: `encode(*values) -> bytes` (signals in DBC order), `decode(data) -> tuple`."""
 
@@ -119,10 +119,9 @@ def _read_dbc(path: Path) -> list[dict]:
                     or s.multiplexer_ids):
                 raise ValueError(f"{path}: {m.name}.{s.name}: only plain little-endian integer "
                                  "signals are supported by the fast codec")
-            sigs.append({"name": s.name, "start": s.start, "length": s.length,
-                         "signed": s.is_signed, "scale": s.scale, "offset": s.offset,
-                         "minimum": s.minimum, "maximum": s.maximum,
-                         "choices": {str(int(k)): str(v) for k, v in (s.choices or {}).items()}})
+            sigs.append(dataclasses.asdict(SignalInfo(
+                s.name, s.start, s.length, s.is_signed, s.scale, s.offset, s.minimum, s.maximum,
+                {int(k): str(v) for k, v in (s.choices or {}).items()})))
         table.append({"name": m.name, "frame_id": m.frame_id, "extended": m.is_extended_frame,
                       "length": m.length, "cycle_ms": m.cycle_time or None, "signals": sigs})
     return table
@@ -174,9 +173,8 @@ def load(path: str | Path = DBC_PATH) -> dict[str, MessageCodec]:
     """Codecs for every message of a DBC file, by message name."""
     out: dict[str, MessageCodec] = {}
     for m in _table(Path(path)):
-        sigs = [SignalInfo(s["name"], s["start"], s["length"], s["signed"], s["scale"],
-                           s["offset"], s["minimum"], s["maximum"],
-                           {int(k): v for k, v in s["choices"].items()})
+        # (JSON keeps the value tables' keys as strings)
+        sigs = [SignalInfo(**{**s, "choices": {int(k): v for k, v in s["choices"].items()}})
                 for s in m["signals"]]
         enc, dec = _build(m["name"], sigs, m["length"])
         out[m["name"]] = MessageCodec(m["name"], m["frame_id"], m["extended"], m["length"],

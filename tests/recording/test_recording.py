@@ -153,6 +153,27 @@ def test_the_fast_reader_reads_what_the_mcap_package_reads(recorded):
     assert sorted(ours) == sorted(theirs) and len(ours) > 1000
 
 
+def test_the_c_path_records_a_flight_as_the_python_does(recorded, tmp_path, monkeypatch):
+    """Of a flight's traces the C path and the Python alone make the same file, byte for byte;
+    the launcher's recording (made with the C path while the run flew, so in another order)
+    holds the same messages."""
+    from ima.recording import fast, write
+
+    run, _ = recorded
+    assert fast.library() is not None
+    write.record(run, output=tmp_path / "c.mcap")
+    monkeypatch.setattr(fast, "_lib", None)
+    write.record(run, output=tmp_path / "python.mcap")
+    assert (tmp_path / "python.mcap").read_bytes() == (tmp_path / "c.mcap").read_bytes()
+
+    def messages(path):
+        with open(path, "rb") as f:
+            return sorted((ch.topic, m.log_time, m.sequence, m.data)
+                          for _, ch, m in make_reader(f).iter_messages(log_time_order=False))
+    launched = messages(run / "run.mcap")
+    assert launched == messages(tmp_path / "python.mcap") and len(launched) > 10000
+
+
 def test_no_recording_leaves_the_traces_for_recover(tmp_path):
     run = tmp_path / "run"
     p = subprocess.run([IMA, "fly", "--duration", "5", "--run-dir", str(run), "--json",

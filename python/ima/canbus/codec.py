@@ -62,11 +62,15 @@ class MessageCodec:
         return dict(zip(self.signal_names, self.decode(data), strict=True))
 
 
+def integral(x: float) -> bool:
+    """Whether a scale or an offset is compiled as an integer literal: a signal whose scale and
+    offset both are decodes to an integer."""
+    return isinstance(x, int) or (x.is_integer() and abs(x) < 2**53)
+
+
 def _num(x: float) -> str:
     """A literal that compiles to exactly `x` (repr round-trips floats)."""
-    if isinstance(x, float) and x.is_integer() and abs(x) < 2**53:
-        return repr(int(x))
-    return repr(x)
+    return repr(int(x)) if integral(x) else repr(x)
 
 
 def _build(name: str, sigs: list[SignalInfo], length: int) -> tuple[Callable, Callable]:

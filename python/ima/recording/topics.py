@@ -97,14 +97,16 @@ class Topics:
         self.skipped[name] = self.skipped.get(name, 0) + 1
 
     def _parsed(self, lines: Lines, name: str):
-        """(number, line, record) of JSON lines; a line that is not a JSON object is skipped."""
+        """(number, line, record) of JSON lines; a line that is not a JSON object with an
+        integer time (if any) is skipped."""
         for i, line in lines:
             try:
                 rec = orjson.loads(line)
             except orjson.JSONDecodeError:
                 self._skip(name)
                 continue
-            if isinstance(rec, dict):
+            if isinstance(rec, dict) and type(rec.get("t_ns", 0)) is int \
+                    and rec.get("t_ns", 0) < 1 << 64:
                 yield i, line, rec
             else:
                 self._skip(name)

@@ -19,12 +19,12 @@ from pathlib import Path
 import orjson
 
 from ima.errors import ImaError
-from ima.recording import schemas
+from ima.recording import fast, schemas
 from ima.recording.follow import feed_until
-from ima.recording.topics import Topics
 
 NAME = "run.mcap"
 CHUNK_BYTES = 1 << 20
+ZSTD_LEVEL = 1  # the traces' JSON: as small as level 3 here, and faster
 POLL_S = 0.05  # how often a followed run's traces are read
 
 
@@ -34,7 +34,7 @@ class _Out:
     def __init__(self, f) -> None:
         from ima.recording.mcapfile import McapWriter
 
-        self.w = McapWriter(f, chunk_bytes=CHUNK_BYTES)
+        self.w = McapWriter(f, chunk_bytes=CHUNK_BYTES, level=ZSTD_LEVEL)
         self.schemas: dict[str, int] = {}
         self.channels: dict[str, int] = {}
 
@@ -137,7 +137,7 @@ def record(run_dir: Path, output: Path | None = None, before_verdicts=None,
     try:
         with open(part, "w+b") as f:
             out = _Out(f)
-            topics = Topics(out)
+            topics = fast.topics(out)
             if follow is not None:
                 feed_until(topics.traces(run_dir, list(nodes or [])), follow, POLL_S)
             launch = _launch(run_dir)
@@ -157,6 +157,8 @@ def record(run_dir: Path, output: Path | None = None, before_verdicts=None,
             _verdicts(out, run_dir, launch)
             _metadata(out, run_dir, launch)
             out.w.finish()
+            if isinstance(topics, fast.FastTopics):
+                topics.close()
         os.replace(part, output)
     except OSError as e:
         part.unlink(missing_ok=True)

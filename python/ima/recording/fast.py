@@ -1,0 +1,270 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The recording's bulk in C: the bus's trace (can.jsonl) and each SKE's trace (nodeK.jsonl)
+turned into MCAP messages by nodes/src/trace_mcap.c (ctypes on libima_trace_mcap.so), written
+straight into the chunk being built. They are nine tenths of a recording's messages, and
+the Python costs a few microseconds for each.
+
+The C writes what Topics.can and Topics.ske write, byte for byte (tests/recording/
+test_fast.py compares whole recordings). A line it does not handle (an event, a cut or garbled
+line, the first frame of an id) it hands back: Topics handles that line, and the C is told
+what Topics learned from it (a new channel, a frame's added fields). Without the library the
+recording is the Python's alone: the same file, made more slowly.
+
+The library is $IMA_TRACE_MCAP_LIB, else <build dir>/nodes/libima_trace_mcap.so."""
+
+from __future__ import annotations
+
+import ctypes
+import itertools
+import os
+from array import array
+from collections.abc import Callable, Iterable
+from functools import partial
+from pathlib import Path
+
+import orjson
+
+from ima.recording.topics import Topics
+
+TM_CAN, TM_SKE = 1, 2
+TM_DONE, TM_PYTHON, TM_FULL = 0, 1, 2
+TM_CAN_FRAMES, TM_SKE_SCHEDULE, TM_SKE_HM, TM_SKE_OTHER = 0, 0, 1, 2
+BATCH_LINES = 50_000  # a whole trace is converted this many lines at a time
+
+Lines = Iterable[tuple[int, bytes]]
+
+
+class _Result(ctypes.Structure):
+    _fields_ = [("consumed", ctypes.c_size_t), ("lines", ctypes.c_uint64),
+                ("part", ctypes.c_uint32), ("out", ctypes.c_void_p),
+                ("out_len", ctypes.c_size_t)]
+
+
+def library_path() -> Path:
+    env = os.environ.get("IMA_TRACE_MCAP_LIB")
+    if env:
+        return Path(env)
+    from ima import paths
+    return paths.build_dir() / "nodes" / "libima_trace_mcap.so"
+
+
+_lib: ctypes.CDLL | None | bool = False  # False: not looked for yet
+
+
+def library() -> ctypes.CDLL | None:
+    """The library, or None if it is not built (the recording is then the Python's)."""
+    global _lib
+    if _lib is False:
+        try:
+            lib = ctypes.CDLL(str(library_path()))
+        except OSError:
+            _lib = None
+            return None
+        c = ctypes
+        for name, res, args in (
+                ("tm_new", c.c_void_p, [c.c_int]),
+                ("tm_free", None, [c.c_void_p]),
+                ("tm_set_channel", None, [c.c_void_p, c.c_int, c.c_uint16]),
+                ("tm_can_message", c.c_int, [c.c_void_p, c.c_uint32, c.c_uint32, c.c_uint16,
+                                             c.c_int]),
+                ("tm_can_signal", c.c_int, [c.c_void_p, c.c_uint32, c.c_uint32, c.c_uint32,
+                                            c.c_int, c.c_int, c.c_double, c.c_double,
+                                            c.c_char_p]),
+                ("tm_can_key", c.c_int, [c.c_void_p, c.c_uint32, c.c_int, c.c_char_p,
+                                         c.c_size_t]),
+                ("tm_convert", c.c_int, [c.c_void_p, c.c_void_p, c.c_size_t, c.c_uint64,
+                                         c.c_uint64, c.c_uint64, c.c_uint32,
+                                         c.POINTER(_Result)]),
+                ("tm_channels", c.c_size_t, [c.c_void_p, c.POINTER(c.POINTER(c.c_uint16))]),
+                ("tm_entries", c.c_size_t, [c.c_void_p, c.c_uint16,
+                                            c.POINTER(c.POINTER(c.c_uint64))]),
+                ("tm_format_double", c.c_size_t, [c.c_double, c.c_char_p])):
+            f = getattr(lib, name)
+            f.restype, f.argtypes = res, args
+        _lib = lib
+    return _lib
+
+
+class _Converter:
+    """Feeds one trace's lines to a C converter writing into `out`'s chunk; the lines it hands
+    back go to `python` (Topics' feeder), after which `learn()` tells the C what is new."""
+
+    def __init__(self, lib: ctypes.CDLL, kind: int, out, python: Callable[[Lines], None]) -> None:
+        self.lib, self.out, self.python = lib, out, python
+        self.conv = lib.tm_new(kind)
+        if not self.conv:
+            raise MemoryError("trace_mcap: no converter")
+        self._res = _Result()
+
+    def close(self) -> None:
+        if self.conv:
+            self.lib.tm_free(self.conv)
+            self.conv = None
+
+    def learn(self) -> None:  # what Topics has registered since
+        pass
+
+    def __call__(self, lines: Lines) -> None:
+        it = iter(lines)
+        while batch := list(itertools.islice(it, BATCH_LINES)):
+            self._batch(batch)
+
+    def _batch(self, lines: list[tuple[int, bytes]]) -> None:
+        if lines[-1][0] - lines[0][0] != len(lines) - 1:  # not numbered in a row: never so
+            self.python(lines)
+            self.learn()
+            return
+        text = b"\n".join([line for _, line in lines]) + b"\n"
+        buf = ctypes.create_string_buffer(text, len(text))
+        base_addr = ctypes.addressof(buf)
+        lib, conv, res, w = self.lib, self.conv, self._res, self.out.w
+        pos = k = skip = 0
+        while k < len(lines):
+            rc = lib.tm_convert(conv, base_addr + pos, len(text) - pos, lines[k][0], len(w.buf),
+                                max(0, w.chunk_bytes - len(w.buf)), skip, ctypes.byref(res))
+            if rc < 0:
+                raise MemoryError("trace_mcap: out of memory")
+            if res.out_len:
+                self._take(res)
+            pos += res.consumed
+            k += res.lines
+            skip = 0
+            if len(w.buf) >= w.chunk_bytes:
+                w._flush_chunk()
+            if rc == TM_FULL:
+                skip = res.part
+            elif rc == TM_PYTHON and k < len(lines):
+                self.python(lines[k:k + 1])
+                self.learn()
+                pos += len(lines[k][1]) + 1
+                k += 1
+
+    def _take(self, res: _Result) -> None:
+        """The records into the chunk, their index entries into its index (each new channel
+        in the order its first message came, as the writer's own message() would)."""
+        w = self.out.w
+        w.buf += ctypes.string_at(res.out, res.out_len)
+        cids = ctypes.POINTER(ctypes.c_uint16)()
+        pairs = ctypes.POINTER(ctypes.c_uint64)()
+        for j in range(self.lib.tm_channels(self.conv, ctypes.byref(cids))):
+            cid = cids[j]
+            n = self.lib.tm_entries(self.conv, cid, ctypes.byref(pairs))
+            if n:
+                idx = w.index.get(cid)
+                if idx is None:
+                    idx = w.index[cid] = []
+                idx += array("Q", ctypes.string_at(pairs, 8 * n))
+
+
+class CanConverter(_Converter):
+    """The bus's trace: its frames and their signals (Topics.can)."""
+
+    def __init__(self, lib: ctypes.CDLL, out, topics: Topics) -> None:
+        super().__init__(lib, TM_CAN, out, partial(Topics.can, topics))
+        from ima.canbus import codec
+
+        self.topics = topics
+        self._keys: set = set()
+        self._signals: dict[int, str] = {}  # DBC id -> its signals' topic, until it has one
+        for msg in codec.BY_ID.values():
+            supported = self._supported(msg)
+            lib.tm_can_message(self.conv, msg.frame_id, msg.length, 0, supported)
+            if supported:
+                for s in msg.signals:
+                    if lib.tm_can_signal(self.conv, msg.frame_id, s.start, s.length, s.signed,
+                                         codec.integral(s.scale) and codec.integral(s.offset),
+                                         s.scale, s.offset, orjson.dumps(s.name) + b":") != 0:
+                        lib.tm_can_message(self.conv, msg.frame_id, msg.length, 0, 0)
+                        supported = False
+                        break
+            if supported:
+                self._signals[msg.frame_id] = f"/can/signals/{msg.name}"
+        self.learn()
+
+    @staticmethod
+    def _supported(msg) -> bool:
+        names = msg.signal_names
+        return (bool(names) and len(set(names)) == len(names)
+                and not {"t_ns", "from"} & set(names) and msg.length <= 64
+                and all(s.length <= 53 for s in msg.signals))
+
+    def learn(self) -> None:
+        from ima.canbus import codec
+
+        lib, conv, channels = self.lib, self.conv, self.out.channels
+        cid = channels.get("/can/frames")
+        if cid:
+            lib.tm_set_channel(conv, TM_CAN_FRAMES, cid)
+        for key, extra in self.topics._extra_of.items():
+            if key in self._keys:
+                continue
+            self._keys.add(key)
+            frame_id, kind, ext = key
+            if kind == "can_tx" and type(frame_id) is int and 0 <= frame_id < 2**32:
+                lib.tm_can_key(conv, frame_id, ext, extra, len(extra))
+        for frame_id, topic in list(self._signals.items()):
+            cid = channels.get(topic)
+            if cid:
+                lib.tm_can_message(conv, frame_id, codec.BY_ID[frame_id].length, cid, 1)
+                del self._signals[frame_id]
+
+
+class SkeConverter(_Converter):
+    """A node's SKE trace: its schedule, its health monitor's events, the rest (Topics.ske)."""
+
+    def __init__(self, lib: ctypes.CDLL, out, topics: Topics, node: str) -> None:
+        super().__init__(lib, TM_SKE, out, partial(Topics.ske, topics, node))
+        self.topics = {TM_SKE_SCHEDULE: f"/{node}/schedule", TM_SKE_HM: f"/{node}/hm",
+                       TM_SKE_OTHER: f"/{node}/events"}
+        self.learn()
+
+    def learn(self) -> None:
+        for which, topic in list(self.topics.items()):
+            cid = self.out.channels.get(topic)
+            if cid:
+                self.lib.tm_set_channel(self.conv, which, cid)
+                del self.topics[which]
+
+
+class FastTopics(Topics):
+    """Topics writing into an MCAP file (write.py's _Out) with the bus's and the SKEs' lines
+    converted by the C."""
+
+    def __init__(self, out, lib: ctypes.CDLL) -> None:
+        super().__init__(out)
+        self._lib = lib
+        self._can: CanConverter | None = None
+        self._ske: dict[str, SkeConverter] = {}
+
+    def can(self, lines: Lines) -> None:
+        if self._can is None:
+            self._can = CanConverter(self._lib, self.out, self)
+        self._can(lines)
+
+    def ske(self, node: str, lines: Lines) -> None:
+        conv = self._ske.get(node)
+        if conv is None:
+            conv = self._ske[node] = SkeConverter(self._lib, self.out, self, node)
+        conv(lines)
+
+    def close(self) -> None:
+        for conv in [self._can, *self._ske.values()]:
+            if conv is not None:
+                conv.close()
+
+
+def topics(out) -> Topics:
+    """The recording's Topics for an MCAP file: FastTopics if the library is built."""
+    lib = library()
+    return Topics(out) if lib is None else FastTopics(out, lib)
+
+
+def format_double(x: float) -> bytes | None:
+    """A float as the C writes it into a signals message (for the tests); None without the
+    library or for a NaN or an infinity."""
+    lib = library()
+    if lib is None:
+        return None
+    buf = ctypes.create_string_buffer(40)
+    n = lib.tm_format_double(x, buf)
+    return buf.raw[:n] if n else None

@@ -138,3 +138,16 @@ def test_numbers_are_written_as_orjson_writes_them():
             assert fast.format_double(x) == orjson.dumps(x), repr(x)
     assert fast.format_double(math.nan) is None
     assert fast.format_double(math.inf) is None
+
+
+def test_a_trace_is_read_a_block_at_a_time_line_by_line(tmp_path):
+    rng = random.Random(3)
+    lines = [b"x" * rng.randrange(0, 40) for _ in range(500)]
+    for text in (b"\n".join(lines) + b"\n", b"\n".join(lines), b"", b"\n\n"):
+        path = tmp_path / "t.jsonl"
+        path.write_bytes(text)
+        with open(path, "rb") as f:
+            expected = [(i, line.rstrip(b"\n")) for i, line in enumerate(f)]
+        for block in (1, 7, 64, 1 << 22):
+            assert list(write._numbered(path, block)) == expected, (block, len(text))
+    assert list(write._numbered(tmp_path / "missing.jsonl")) == []

@@ -50,7 +50,9 @@ def _text(raw: bytes) -> str:
 
 
 def _named(fields: tuple[str, ...], values: tuple) -> dict:
-    return {k: v for k, v in zip(fields, values, strict=True) if k != "pad"}
+    d = dict(zip(fields, values, strict=True))
+    d.pop("pad", None)
+    return d
 
 
 @dataclass

@@ -59,15 +59,22 @@ class _Out:
         self.w.message(ch, seq, t_ns if t_ns > 0 else 0, data)
 
 
-def _numbered(path: Path):
-    """(number, line without its newline) of a trace; nothing if it cannot be read."""
+def _numbered(path: Path, block: int = 1 << 22):
+    """(number, line without its newline) of a trace, read a block at a time; nothing if it
+    cannot be read."""
     try:
         f = open(path, "rb")  # noqa: SIM115 - closed below
     except OSError:
         return
     with f:
-        for i, line in enumerate(f):
-            yield i, line.rstrip(b"\n")
+        n, tail = 0, b""
+        while data := f.read(block):
+            lines = (tail + data).split(b"\n")
+            tail = lines.pop()
+            yield from enumerate(lines, n)
+            n += len(lines)
+        if tail:
+            yield n, tail
 
 
 def _fdr(out: _Out, run_dir: Path, node: str) -> None:

@@ -240,7 +240,7 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
         if not console.is_terminal:
             # nobody watches (a pipe, a file, a campaign, a benchmark): no live view to
             # follow the traces for and draw
-            result = launch_run.launch(opts)
+            result = launch_run.launch(opts, system=system)
         else:
             with Live(progress, console=console, transient=True, refresh_per_second=4) as live:
                 def on_status(st: dict) -> None:
@@ -248,7 +248,7 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
                     progress.update(task, completed=min(st.get("t_s", 0), opts.duration_s))
                     live.update(Group(state.render(), progress))
 
-                result = launch_run.launch(opts, on_status=on_status)
+                result = launch_run.launch(opts, on_status=on_status, system=system)
     except BaseException:
         recording.abandon(recorder, Path(opts.run_dir))
         raise

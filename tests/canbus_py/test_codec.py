@@ -10,7 +10,7 @@ import random
 import cantools
 import pytest
 
-from ima.canbus import codec
+from ima.canbus import codec, dbc_table
 
 DB = cantools.database.load_file(str(codec.DBC_PATH))
 NAMES = sorted(m.name for m in DB.messages)
@@ -95,7 +95,7 @@ def test_the_dbc_cache_gives_the_same_codecs_and_follows_the_file(tmp_path, monk
     (cache,) = (tmp_path / "build" / "dbc-cache").iterdir()
     assert _layouts(first) == _layouts(codec.MESSAGES)
     calls = []
-    monkeypatch.setattr(codec, "_read_dbc", lambda p: calls.append(p) or [])
+    monkeypatch.setattr(dbc_table, "_read", lambda p: calls.append(p) or [])
     assert _layouts(codec.load(dbc)) == _layouts(first) and calls == []  # from the cache
     m = first["AHRS_ATT"]
     data = m.encode(12.5, -3.25, 271.0, 3, 7)
@@ -107,4 +107,21 @@ def test_the_dbc_cache_gives_the_same_codecs_and_follows_the_file(tmp_path, monk
     cache.write_text("{not json")
     dbc.write_bytes(codec.DBC_PATH.read_bytes())
     assert _layouts(codec.load(dbc)) == _layouts(first)
-    assert json.loads(cache.read_text())["layout"] == codec._CACHE_LAYOUT
+    assert json.loads(cache.read_text())["layout"] == dbc_table.LAYOUT
+
+
+def test_a_signal_the_fast_codec_cannot_decode_is_refused_by_it_not_by_the_table(tmp_path,
+                                                                                  monkeypatch):
+    """The deployment reads any DBC's messages through the cache; the fast codec refuses a
+    big-endian signal when it is built."""
+    monkeypatch.setenv("IMA_BUILD_DIR", str(tmp_path / "build"))
+    (tmp_path / "build").mkdir()
+    dbc = tmp_path / "motorola.dbc"
+    dbc.write_text('VERSION ""\n\nBU_: A\n\nBO_ 291 M: 8 A\n'
+                   ' SG_ LE : 0|8@1+ (1,0) [0|255] "" A\n'
+                   ' SG_ BE : 15|8@0+ (1,0) [0|255] "" A\n')
+    for _ in range(2):  # read, then from the cache
+        (m,) = dbc_table.table(dbc)
+        assert (m["name"], m["frame_id"], m["unsupported"]) == ("M", 291, "M.BE")
+    with pytest.raises(ValueError, match="M.BE"):
+        codec.load(dbc)

@@ -6,7 +6,7 @@ microseconds per frame; the world sends and receives a few hundred thousand fram
 So, at import, each message's signals are turned into one small Python function doing plain
 integer shifts (all our signals are little-endian), compiled once. A test checks every message
 against cantools over random values. What cantools read of a DBC is kept in the build tree
-(`dbc-cache/`, by the file's content), so that the processes of a run do not each import it.
+(dbc_table.py), so that the processes of a run do not each import it.
 
 Encoding rounds like cantools (round((value - offset) / scale)) and then saturates at the
 raw range of the signal instead of failing: a sensor that reads past its field's range sends
@@ -16,11 +16,10 @@ the range's end. Decoding returns physical values as floats (ints for scale-1 si
 from __future__ import annotations
 
 import dataclasses
-import hashlib
-import json
-import os
 from collections.abc import Callable
 from pathlib import Path
+
+from ima.canbus import dbc_table
 
 DBC_PATH = Path(__file__).resolve().parents[3] / "config" / "can" / "rpas.dbc"
 
@@ -103,80 +102,13 @@ def _build(name: str, sigs: list[SignalInfo], length: int) -> tuple[Callable, Ca
     return ns["encode"], ns["decode"]
 
 
-# The messages and signals cantools read from a DBC, kept in the build tree by the file's
-# content (every process of a run loads the DBC: the world, the recorder; importing cantools
-# alone takes some 90 ms of CPU). A change of the file, of this layout or of cantools's
-# version is another key.
-_CACHE_LAYOUT = 1
-
-
-def _read_dbc(path: Path) -> list[dict]:
-    """Every message of a DBC as cantools reads it, checked for what the fast codec supports."""
-    import cantools  # only here: the generated codecs do not need it
-
-    db = cantools.database.load_file(str(path), strict=True)
-    table = []
-    for m in db.messages:
-        sigs = []
-        for s in m.signals:
-            if (s.byte_order != "little_endian" or s.is_float or s.is_multiplexer
-                    or s.multiplexer_ids):
-                raise ValueError(f"{path}: {m.name}.{s.name}: only plain little-endian integer "
-                                 "signals are supported by the fast codec")
-            sigs.append(dataclasses.asdict(SignalInfo(
-                s.name, s.start, s.length, s.is_signed, s.scale, s.offset, s.minimum, s.maximum,
-                {int(k): str(v) for k, v in (s.choices or {}).items()})))
-        table.append({"name": m.name, "frame_id": m.frame_id, "extended": m.is_extended_frame,
-                      "length": m.length, "cycle_ms": m.cycle_time or None, "signals": sigs})
-    return table
-
-
-def _cache_file(data: bytes) -> Path | None:
-    from ima import paths
-
-    build = paths.build_dir()
-    if not build.is_dir():
-        return None
-    from importlib import metadata
-
-    try:
-        reader = metadata.version("cantools")
-    except metadata.PackageNotFoundError:
-        reader = "?"
-    key = hashlib.sha256(data + f"\0layout {_CACHE_LAYOUT} cantools {reader}".encode()
-                         ).hexdigest()[:32]
-    return build / "dbc-cache" / f"{key}.json"
-
-
-def _table(path: Path) -> list[dict]:
-    """The DBC's messages: from the cache when this very file was read before, else read and
-    kept (best effort: a cache that cannot be written or read is read around)."""
-    data = path.read_bytes()
-    cache = _cache_file(data)
-    if cache is not None:
-        try:
-            doc = json.loads(cache.read_text())
-            if doc.get("layout") == _CACHE_LAYOUT:
-                return doc["messages"]
-        except (OSError, ValueError, KeyError, TypeError, AttributeError):
-            pass
-    table = _read_dbc(path)
-    if cache is not None:
-        try:
-            cache.parent.mkdir(exist_ok=True)
-            tmp = cache.with_name(f"{cache.name}.{os.getpid()}.part")
-            tmp.write_text(json.dumps({"layout": _CACHE_LAYOUT, "dbc": str(path),
-                                       "messages": table}))
-            os.replace(tmp, cache)
-        except OSError:
-            pass
-    return table
-
-
 def load(path: str | Path = DBC_PATH) -> dict[str, MessageCodec]:
     """Codecs for every message of a DBC file, by message name."""
     out: dict[str, MessageCodec] = {}
-    for m in _table(Path(path)):
+    for m in dbc_table.table(Path(path)):
+        if m["unsupported"]:
+            raise ValueError(f"{path}: {m['unsupported']}: only plain little-endian integer "
+                             "signals are supported by the fast codec")
         # (JSON keeps the value tables' keys as strings)
         sigs = [SignalInfo(**{**s, "choices": {int(k): v for k, v in s["choices"].items()}})
                 for s in m["signals"]]

@@ -607,8 +607,8 @@ HM_LOG_SIZE = 232
 @functools.lru_cache(maxsize=8)
 def _dbc_ids(path: str, mtime_ns: int) -> tuple[tuple[str, int], ...]:
     """A DBC's (message name, frame identifier), read once per version of the file (a
-    campaign loads the same model for every run)."""
-    import cantools  # noqa: PLC0415 (slow to import; only needed here)
+    campaign loads the same model for every run), from the build tree's cache of it when it
+    is there (ima.canbus.dbc_table)."""
+    from ima.canbus import dbc_table
 
-    db = cantools.database.load_file(path, database_format="dbc")
-    return tuple((m.name, m.frame_id) for m in db.messages)
+    return tuple((m["name"], m["frame_id"]) for m in dbc_table.table(Path(path)))

@@ -16,10 +16,13 @@ against the DBC's cycle times, the gaps and the deadline misses; error frames, b
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ima.trace import bits
-from ima.trace.columns import Columns
 from ima.trace.source import Trace
+
+if TYPE_CHECKING:  # numpy is imported when statistics are computed, not with the CLI
+    from ima.trace.columns import Columns
 
 DEFAULT_WINDOW_S = 1.0
 DEFAULT_BITRATE = 1_000_000
@@ -63,7 +66,7 @@ def compute(trace: Trace | Columns, dbc=None, window_s: float = DEFAULT_WINDOW_S
 
     from ima.trace import columns
 
-    c = trace if isinstance(trace, Columns) else columns.of_trace(trace)
+    c = trace if isinstance(trace, columns.Columns) else columns.of_trace(trace)
     rate = bitrate or c.bitrate or DEFAULT_BITRATE
     win_ns = max(1, round(window_s * 1e9))
     ok = ~c.error

@@ -3,7 +3,7 @@
  * sure to do exactly as the recorder's Python does, it hands back (TM_PYTHON). */
 #include "trace_mcap/trace_mcap.h"
 
-#include "trace_mcap__digits.h"
+#include "trace_mcap__parts.h"
 
 #include <math.h>
 #include <stdbool.h>
@@ -16,7 +16,7 @@
 #define MAX_EXTRA 256
 #define MAX_KEY 64
 #define MAX_DATA 64    /* CAN FD's largest payload */
-#define MAX_DIGITS 18  /* integers longer than this are the Python's to read */
+#define MAX_DIGITS 18  /* as trace_mcap_json.c reads them */
 #define OP_MESSAGE 0x05
 #define MSG_HEAD 31    /* opcode, record length, channel, sequence, log and publish time */
 
@@ -255,214 +255,6 @@ static uint8_t *message(tm_conv_t *c, uint16_t cid, uint64_t seq, uint64_t t, ui
     return h + MSG_HEAD;
 }
 
-/* ---- numbers as orjson writes them ----------------------------------------------------------- */
-
-static size_t put_u64(char *p, uint64_t v)
-{
-    char tmp[24];
-    size_t n = 0;
-    do {
-        tmp[n++] = (char)('0' + v % 10);
-        v /= 10;
-    } while (v);
-    for (size_t i = 0; i < n; i++)
-        p[i] = tmp[n - 1 - i];
-    return n;
-}
-
-static size_t put_i64(char *p, int64_t v)
-{
-    if (v >= 0)
-        return put_u64(p, (uint64_t)v);
-    p[0] = '-';
-    return 1 + put_u64(p + 1, (uint64_t)0 - (uint64_t)v);
-}
-
-size_t tm_format_double(double x, char *buf)
-{
-    if (x != x || x - x != 0)
-        return 0; /* NaN, infinity */
-    size_t n = 0;
-    if (signbit(x)) {
-        buf[n++] = '-';
-        x = -x;
-    }
-    if (x == 0) {
-        memcpy(buf + n, "0.0", 3);
-        return n + 3;
-    }
-    char d[20];
-    int k;
-    size_t nd = tm__shortest(x, d, &k);
-    if (k > 0 && k <= 16) {
-        if ((size_t)k >= nd) { /* 1234e7 -> 12340000000.0 */
-            memcpy(buf + n, d, nd);
-            n += nd;
-            for (size_t i = nd; i < (size_t)k; i++)
-                buf[n++] = '0';
-            memcpy(buf + n, ".0", 2);
-            return n + 2;
-        }
-        memcpy(buf + n, d, (size_t)k); /* 1234e-2 -> 12.34 */
-        n += (size_t)k;
-        buf[n++] = '.';
-        memcpy(buf + n, d + k, nd - (size_t)k);
-        return n + nd - (size_t)k;
-    }
-    if (k <= 0 && k > -5) { /* 1234e-7 -> 0.0001234 */
-        memcpy(buf + n, "0.", 2);
-        n += 2;
-        for (int i = 0; i < -k; i++)
-            buf[n++] = '0';
-        memcpy(buf + n, d, nd);
-        return n + nd;
-    }
-    buf[n++] = d[0]; /* 1e-7, 1.5e+300 */
-    if (nd > 1) {
-        buf[n++] = '.';
-        memcpy(buf + n, d + 1, nd - 1);
-        n += nd - 1;
-    }
-    buf[n++] = 'e';
-    int e = k - 1;
-    buf[n++] = e < 0 ? '-' : '+';
-    return n + put_u64(buf + n, (uint64_t)(e < 0 ? -e : e));
-}
-
-/* ---- reading a bus line ----------------------------------------------------------------------- */
-
-typedef struct {
-    const uint8_t *p;
-    size_t n;
-} span_t;
-
-enum { V_NONE, V_STR, V_INT, V_TRUE, V_FALSE, V_NULL };
-
-typedef struct {
-    int type;
-    span_t s;  /* a string's content, an integer's digits */
-    bool neg;
-} value_t;
-
-/* The fields of a bus line the recording reads. */
-typedef struct {
-    value_t t_ns, kind, id, ext, rtr, data, from;
-} can_line_t;
-
-static bool eq(span_t s, const char *lit)
-{
-    size_t n = strlen(lit);
-    return s.n == n && memcmp(s.p, lit, n) == 0;
-}
-
-/* A string's content up to its closing quote: printable ASCII without escapes only (what orjson
- * would read and write back the same). */
-static const uint8_t *read_string(const uint8_t *p, const uint8_t *end, span_t *out)
-{
-    const uint8_t *s = ++p;
-    while (p < end && *p != '"') {
-        if (*p < 0x20 || *p > 0x7E || *p == '\\')
-            return NULL;
-        p++;
-    }
-    if (p == end)
-        return NULL;
-    *out = (span_t){s, (size_t)(p - s)};
-    return p + 1;
-}
-
-static const uint8_t *read_value(const uint8_t *p, const uint8_t *end, value_t *v)
-{
-    if (p == end)
-        return NULL;
-    if (*p == '"') {
-        v->type = V_STR;
-        return read_string(p, end, &v->s);
-    }
-    if (*p == '-' || (*p >= '0' && *p <= '9')) {
-        v->type = V_INT;
-        v->neg = *p == '-';
-        if (v->neg)
-            p++;
-        const uint8_t *s = p;
-        while (p < end && *p >= '0' && *p <= '9')
-            p++;
-        size_t n = (size_t)(p - s);
-        if (n == 0 || n > MAX_DIGITS || (n > 1 && *s == '0'))
-            return NULL;
-        if (p < end && (*p == '.' || *p == 'e' || *p == 'E'))
-            return NULL; /* a float: the Python's */
-        v->s = (span_t){s, n};
-        return p;
-    }
-    static const struct { const char *lit; int type; } words[] = {
-        {"true", V_TRUE}, {"false", V_FALSE}, {"null", V_NULL}};
-    for (size_t i = 0; i < 3; i++) {
-        size_t n = strlen(words[i].lit);
-        if ((size_t)(end - p) >= n && memcmp(p, words[i].lit, n) == 0) {
-            v->type = words[i].type;
-            return p + n;
-        }
-    }
-    return NULL; /* an object, an array, anything else */
-}
-
-/* A flat JSON object without white space, every string plain: the bus's own form. */
-static bool read_can_line(const uint8_t *p, const uint8_t *end, can_line_t *l)
-{
-    memset(l, 0, sizeof *l);
-    if (end - p < 2 || *p != '{' || end[-1] != '}')
-        return false;
-    p++;
-    if (*p == '}')
-        return false;
-    for (;;) {
-        span_t key;
-        if (p == end || *p != '"' || !(p = read_string(p, end, &key)) || p == end || *p != ':')
-            return false;
-        value_t v = {0};
-        if (!(p = read_value(p + 1, end, &v)) || p == end)
-            return false;
-        value_t *slot = eq(key, "t_ns")   ? &l->t_ns
-                        : eq(key, "kind") ? &l->kind
-                        : eq(key, "id")   ? &l->id
-                        : eq(key, "ext")  ? &l->ext
-                        : eq(key, "rtr")  ? &l->rtr
-                        : eq(key, "data") ? &l->data
-                        : eq(key, "from") ? &l->from
-                                          : NULL;
-        if (slot) {
-            if (slot->type != V_NONE)
-                return false; /* a repeated field: the Python's */
-            *slot = v;
-        }
-        if (*p == '}')
-            return p + 1 == end;
-        if (*p != ',')
-            return false;
-        p++;
-    }
-}
-
-static uint64_t digits_value(span_t s)
-{
-    uint64_t v = 0;
-    for (size_t i = 0; i < s.n; i++)
-        v = 10 * v + (uint64_t)(s.p[i] - '0');
-    return v;
-}
-
-static int hex_digit(uint8_t h)
-{
-    if (h >= '0' && h <= '9')
-        return h - '0';
-    if (h >= 'a' && h <= 'f')
-        return h - 'a' + 10;
-    if (h >= 'A' && h <= 'F')
-        return h - 'A' + 10;
-    return -1;
-}
-
 /* The raw value of a little-endian signal. */
 static uint64_t raw_bits(const uint8_t *data, uint32_t start, uint32_t length)
 {
@@ -495,7 +287,7 @@ static size_t signals_json(const tm_message_t *m, const uint8_t *data, const can
             if (__builtin_mul_overflow(r, (int64_t)s->scale, &v) ||
                 __builtin_add_overflow(v, (int64_t)s->offset, &v))
                 return 0;
-            n += put_i64(buf + n, v);
+            n += tm__put_i64(buf + n, v);
         } else {
             size_t k = tm_format_double((double)r * s->scale + s->offset, buf + n);
             if (!k)
@@ -528,18 +320,18 @@ static int can_line(tm_conv_t *c, const uint8_t *p, const uint8_t *end, uint64_t
                     uint64_t base, uint64_t room, uint32_t skip, uint32_t *part)
 {
     can_line_t l;
-    if (!c->cid[TM_CAN_FRAMES] || !read_can_line(p, end, &l))
+    if (!c->cid[TM_CAN_FRAMES] || !tm__read_can_line(p, end, &l))
         return 1;
     /* a can_tx frame with its time, id and formats as the bus writes them */
-    if (l.kind.type != V_STR || !eq(l.kind.s, "can_tx") || l.t_ns.type != V_INT || l.t_ns.neg ||
-        l.id.type != V_INT || l.id.neg || digits_value(l.id.s) > UINT32_MAX)
+    if (l.kind.type != V_STR || !tm__eq(l.kind.s, "can_tx") || l.t_ns.type != V_INT || l.t_ns.neg ||
+        l.id.type != V_INT || l.id.neg || tm__digits_value(l.id.s) > UINT32_MAX)
         return 1;
     if ((l.ext.type != V_NONE && l.ext.type != V_TRUE && l.ext.type != V_FALSE) ||
         (l.rtr.type != V_NONE && l.rtr.type != V_TRUE && l.rtr.type != V_FALSE) ||
         (l.data.type != V_NONE && l.data.type != V_STR) ||
         (l.from.type != V_NONE && l.from.type != V_STR && l.from.type != V_NULL))
         return 1;
-    uint32_t id = (uint32_t)digits_value(l.id.s);
+    uint32_t id = (uint32_t)tm__digits_value(l.id.s);
     const tm_key_t *key = find_key(c, id, l.ext.type == V_TRUE);
     if (!key)
         return 1;
@@ -555,7 +347,7 @@ static int can_line(tm_conv_t *c, const uint8_t *p, const uint8_t *end, uint64_t
         if (!m->sig_cid || hex.n % 2 || hex.n / 2 > MAX_DATA || m->n == 0)
             return 1; /* no channel yet, an odd length (no signals) or a long one */
         for (size_t i = 0; i < hex.n / 2; i++) {
-            int hi = hex_digit(hex.p[2 * i]), lo = hex_digit(hex.p[2 * i + 1]);
+            int hi = tm__hex_digit(hex.p[2 * i]), lo = tm__hex_digit(hex.p[2 * i + 1]);
             if (hi < 0 || lo < 0)
                 return 1;
             if (i < m->length)
@@ -564,11 +356,11 @@ static int can_line(tm_conv_t *c, const uint8_t *p, const uint8_t *end, uint64_t
         if (!(json_n = signals_json(m, data, &l, json)))
             return 1;
     }
-    uint64_t t = digits_value(l.t_ns.s);
+    uint64_t t = tm__digits_value(l.t_ns.s);
     if (skip == 0) {
         /* the bus's line with its added fields and its record number */
         char num[24];
-        size_t num_n = put_u64(num, seq);
+        size_t num_n = tm__put_u64(num, seq);
         size_t line_n = (size_t)(end - p) - 1;
         size_t n = line_n + key->n + 7 + num_n + 1;
         uint8_t *d = message(c, c->cid[TM_CAN_FRAMES], seq, t, base, n);
@@ -614,7 +406,7 @@ static int ske_line(tm_conv_t *c, const uint8_t *p, const uint8_t *end, uint64_t
     for (const uint8_t *q = p + 8; q < comma; q++)
         if (*q < '0' || *q > '9')
             return 1; /* a sign, a space, an underscore: the Python's */
-    uint64_t t = digits_value((span_t){p + 8, (size_t)(comma - p - 8)});
+    uint64_t t = tm__digits_value((span_t){p + 8, (size_t)(comma - p - 8)});
     const uint8_t *k = find(p, end, "\"kind\":\"");
     span_t kind = {(const uint8_t *)"", 0};
     if (k) {
@@ -624,8 +416,8 @@ static int ske_line(tm_conv_t *c, const uint8_t *p, const uint8_t *end, uint64_t
             return 1;
         kind = (span_t){k, (size_t)(q - k)};
     }
-    int which = eq(kind, "window_start") || eq(kind, "window_end") ? TM_SKE_SCHEDULE
-                : eq(kind, "hm")                                    ? TM_SKE_HM
+    int which = tm__eq(kind, "window_start") || tm__eq(kind, "window_end") ? TM_SKE_SCHEDULE
+                : tm__eq(kind, "hm")                                    ? TM_SKE_HM
                                                                     : TM_SKE_OTHER;
     if (!c->cid[which])
         return 1;

@@ -4,7 +4,7 @@
 #include <charconv>
 #include <cstdlib>
 
-#include "trace_mcap__digits.h"
+#include "trace_mcap__parts.h"
 
 // x > 0 and finite: x = 0.DIGITS * 10^point; the number of digits (at most 17).
 extern "C" size_t tm__shortest(double x, char *digits, int *point)

@@ -57,32 +57,33 @@ def library() -> ctypes.CDLL | None:
     if _lib is False:
         try:
             lib = ctypes.CDLL(str(library_path()))
-        except OSError:
+            _declare(lib)
+        except (OSError, AttributeError):  # not built, or an older build without a symbol
             _lib = None
             return None
-        c = ctypes
-        for name, res, args in (
-                ("tm_new", c.c_void_p, [c.c_int]),
-                ("tm_free", None, [c.c_void_p]),
-                ("tm_set_channel", None, [c.c_void_p, c.c_int, c.c_uint16]),
-                ("tm_can_message", c.c_int, [c.c_void_p, c.c_uint32, c.c_uint32, c.c_uint16,
-                                             c.c_int]),
-                ("tm_can_signal", c.c_int, [c.c_void_p, c.c_uint32, c.c_uint32, c.c_uint32,
-                                            c.c_int, c.c_int, c.c_double, c.c_double,
-                                            c.c_char_p]),
-                ("tm_can_key", c.c_int, [c.c_void_p, c.c_uint32, c.c_int, c.c_char_p,
-                                         c.c_size_t]),
-                ("tm_convert", c.c_int, [c.c_void_p, c.c_void_p, c.c_size_t, c.c_uint64,
-                                         c.c_uint64, c.c_uint64, c.c_uint32,
-                                         c.POINTER(_Result)]),
-                ("tm_channels", c.c_size_t, [c.c_void_p, c.POINTER(c.POINTER(c.c_uint16))]),
-                ("tm_entries", c.c_size_t, [c.c_void_p, c.c_uint16,
-                                            c.POINTER(c.POINTER(c.c_uint64))]),
-                ("tm_format_double", c.c_size_t, [c.c_double, c.c_char_p])):
-            f = getattr(lib, name)
-            f.restype, f.argtypes = res, args
         _lib = lib
     return _lib
+
+
+def _declare(lib: ctypes.CDLL) -> None:
+    c = ctypes
+    for name, res, args in (
+            ("tm_new", c.c_void_p, [c.c_int]),
+            ("tm_free", None, [c.c_void_p]),
+            ("tm_set_channel", None, [c.c_void_p, c.c_int, c.c_uint16]),
+            ("tm_can_message", c.c_int, [c.c_void_p, c.c_uint32, c.c_uint32, c.c_uint16,
+                                         c.c_int]),
+            ("tm_can_signal", c.c_int, [c.c_void_p, c.c_uint32, c.c_uint32, c.c_uint32,
+                                        c.c_int, c.c_int, c.c_double, c.c_double, c.c_char_p]),
+            ("tm_can_key", c.c_int, [c.c_void_p, c.c_uint32, c.c_int, c.c_char_p, c.c_size_t]),
+            ("tm_convert", c.c_int, [c.c_void_p, c.c_void_p, c.c_size_t, c.c_uint64,
+                                     c.c_uint64, c.c_uint64, c.c_uint32, c.POINTER(_Result)]),
+            ("tm_channels", c.c_size_t, [c.c_void_p, c.POINTER(c.POINTER(c.c_uint16))]),
+            ("tm_entries", c.c_size_t, [c.c_void_p, c.c_uint16,
+                                        c.POINTER(c.POINTER(c.c_uint64))]),
+            ("tm_format_double", c.c_size_t, [c.c_double, c.c_char_p])):
+        f = getattr(lib, name)
+        f.restype, f.argtypes = res, args
 
 
 class _Converter:
@@ -120,17 +121,16 @@ class _Converter:
         lib, conv, res, w = self.lib, self.conv, self._res, self.out.w
         pos = k = skip = 0
         while k < len(lines):
-            rc = lib.tm_convert(conv, base_addr + pos, len(text) - pos, lines[k][0], len(w.buf),
-                                max(0, w.chunk_bytes - len(w.buf)), skip, ctypes.byref(res))
+            used = w.chunk_used()
+            rc = lib.tm_convert(conv, base_addr + pos, len(text) - pos, lines[k][0], used,
+                                max(0, w.chunk_bytes - used), skip, ctypes.byref(res))
             if rc < 0:
                 raise MemoryError("trace_mcap: out of memory")
             if res.out_len:
-                self._take(res)
+                w.add_records(ctypes.string_at(res.out, res.out_len), self._entries())
             pos += res.consumed
             k += res.lines
             skip = 0
-            if len(w.buf) >= w.chunk_bytes:
-                w._flush_chunk()
             if rc == TM_FULL:
                 skip = res.part
             elif rc == TM_PYTHON and k < len(lines):
@@ -139,21 +139,18 @@ class _Converter:
                 pos += len(lines[k][1]) + 1
                 k += 1
 
-    def _take(self, res: _Result) -> None:
-        """The records into the chunk, their index entries into its index (each new channel
-        in the order its first message came, as the writer's own message() would)."""
-        w = self.out.w
-        w.buf += ctypes.string_at(res.out, res.out_len)
+    def _entries(self) -> list[tuple[int, array]]:
+        """The last call's index entries, channel by channel in the order of each one's first
+        record (as the writer's own message() would have made them)."""
         cids = ctypes.POINTER(ctypes.c_uint16)()
         pairs = ctypes.POINTER(ctypes.c_uint64)()
+        out = []
         for j in range(self.lib.tm_channels(self.conv, ctypes.byref(cids))):
             cid = cids[j]
             n = self.lib.tm_entries(self.conv, cid, ctypes.byref(pairs))
             if n:
-                idx = w.index.get(cid)
-                if idx is None:
-                    idx = w.index[cid] = []
-                idx += array("Q", ctypes.string_at(pairs, 8 * n))
+                out.append((cid, array("Q", ctypes.string_at(pairs, 8 * n))))
+        return out
 
 
 class CanConverter(_Converter):
@@ -254,9 +251,16 @@ class FastTopics(Topics):
 
 
 def topics(out) -> Topics:
-    """The recording's Topics for an MCAP file: FastTopics if the library is built."""
+    """The recording's Topics for an MCAP file: FastTopics if the library is built (close()
+    it when done)."""
     lib = library()
     return Topics(out) if lib is None else FastTopics(out, lib)
+
+
+def close(topics: Topics) -> None:
+    """Frees what topics() made in C."""
+    if isinstance(topics, FastTopics):
+        topics.close()
 
 
 def format_double(x: float) -> bytes | None:

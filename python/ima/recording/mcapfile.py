@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import struct
 import zlib
+from array import array
 
 MAGIC = b"\x89MCAP0\r\n"
 OP_HEADER, OP_FOOTER, OP_SCHEMA, OP_CHANNEL, OP_MESSAGE, OP_CHUNK = 1, 2, 3, 4, 5, 6
@@ -100,6 +101,23 @@ class McapWriter:
         buf += _MSG.pack(OP_MESSAGE, 22 + len(data), cid, seq & 0xFFFFFFFF, t, t)
         buf += data
         if len(buf) >= self.chunk_bytes:
+            self._flush_chunk()
+
+    def chunk_used(self) -> int:
+        """Bytes of the chunk being built: where the next record goes."""
+        return len(self.buf)
+
+    def add_records(self, data: bytes, entries: list[tuple[int, array]]) -> None:
+        """Message records made elsewhere (recording/fast.py), with each channel's index
+        entries (log time, offset in the chunk; the channels in the order of their first
+        record); the chunk is written if full, as after message()."""
+        self.buf += data
+        for cid, pairs in entries:
+            idx = self.index.get(cid)
+            if idx is None:
+                idx = self.index[cid] = []
+            idx += pairs
+        if len(self.buf) >= self.chunk_bytes:
             self._flush_chunk()
 
     def _flush_chunk(self) -> None:

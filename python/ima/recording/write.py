@@ -145,27 +145,28 @@ def record(run_dir: Path, output: Path | None = None, before_verdicts=None,
         with open(part, "w+b") as f:
             out = _Out(f)
             topics = fast.topics(out)
-            if follow is not None:
-                feed_until(topics.traces(run_dir, list(nodes or [])), follow, POLL_S)
-            launch = _launch(run_dir)
-            nodes = list(nodes or launch.get("nodes") or sorted(
-                p.stem for p in run_dir.glob("node*.jsonl") if p.stem[4:].isdigit()))
-            if follow is None:
-                topics.can(_numbered(run_dir / "can.jsonl"))
-                for k, node in enumerate(nodes, start=1):
-                    topics.ske(node, _numbered(run_dir / f"{node}.jsonl"))
-                    topics.dds(node, f"dds{k}.jsonl", _numbered(run_dir / f"dds{k}.jsonl"))
-                topics.world(_numbered(run_dir / "world.jsonl"))
-                topics.truth(_numbered(run_dir / "truth.jsonl"))
-            for node in nodes:
-                _fdr(out, run_dir, node)
-            if before_verdicts is not None:
-                before_verdicts()
-            _verdicts(out, run_dir, launch)
-            _metadata(out, run_dir, launch)
-            out.w.finish()
-            if isinstance(topics, fast.FastTopics):
-                topics.close()
+            try:
+                if follow is not None:
+                    feed_until(topics.traces(run_dir, list(nodes or [])), follow, POLL_S)
+                launch = _launch(run_dir)
+                nodes = list(nodes or launch.get("nodes") or sorted(
+                    p.stem for p in run_dir.glob("node*.jsonl") if p.stem[4:].isdigit()))
+                if follow is None:
+                    topics.can(_numbered(run_dir / "can.jsonl"))
+                    for k, node in enumerate(nodes, start=1):
+                        topics.ske(node, _numbered(run_dir / f"{node}.jsonl"))
+                        topics.dds(node, f"dds{k}.jsonl", _numbered(run_dir / f"dds{k}.jsonl"))
+                    topics.world(_numbered(run_dir / "world.jsonl"))
+                    topics.truth(_numbered(run_dir / "truth.jsonl"))
+                for node in nodes:
+                    _fdr(out, run_dir, node)
+                if before_verdicts is not None:
+                    before_verdicts()
+                _verdicts(out, run_dir, launch)
+                _metadata(out, run_dir, launch)
+                out.w.finish()
+            finally:
+                fast.close(topics)  # its C converters
         os.replace(part, output)
     except OSError as e:
         part.unlink(missing_ok=True)

@@ -151,3 +151,22 @@ def test_a_trace_is_read_a_block_at_a_time_line_by_line(tmp_path):
         for block in (1, 7, 64, 1 << 22):
             assert list(write._numbered(path, block)) == expected, (block, len(text))
     assert list(write._numbered(tmp_path / "missing.jsonl")) == []
+
+
+def test_more_messages_than_the_c_holds_are_recorded_all_the_same(tmp_path, monkeypatch):
+    """A DBC of 300 messages: the C's table holds 256; the frames of the others are the
+    Python's, and the file is the same."""
+    import dataclasses
+
+    base = codec.BY_ID[min(codec.BY_ID)]
+    many = {0x1000 + k: dataclasses.replace(base, name=f"M{k}", frame_id=0x1000 + k)
+            for k in range(300)}
+    monkeypatch.setattr(codec, "BY_ID", many)
+    run = tmp_path / "run"
+    run.mkdir()
+    rng = random.Random(9)
+    lines = [_can_tx(160000 * (k + 1), msg, _random_frame(rng, msg))
+             for k, msg in enumerate(list(many.values()) * 2)]
+    (run / "can.jsonl").write_text("\n".join(lines) + "\n")
+    assert _record(run, tmp_path / "c.mcap", True, monkeypatch) == \
+        _record(run, tmp_path / "py.mcap", False, monkeypatch)

@@ -162,10 +162,13 @@ class CanConverter(_Converter):
 
         self.topics = topics
         self._keys: set = set()
+        self._python_ids: set[int] = set()  # DBC ids the C could not take: theirs stay Python's
         self._signals: dict[int, str] = {}  # DBC id -> its signals' topic, until it has one
         for msg in codec.BY_ID.values():
             supported = self._supported(msg)
-            lib.tm_can_message(self.conv, msg.frame_id, msg.length, 0, supported)
+            if lib.tm_can_message(self.conv, msg.frame_id, msg.length, 0, supported) != 0:
+                self._python_ids.add(msg.frame_id)  # too many messages for its table
+                continue
             if supported:
                 for s in msg.signals:
                     if lib.tm_can_signal(self.conv, msg.frame_id, s.start, s.length, s.signed,
@@ -197,7 +200,8 @@ class CanConverter(_Converter):
                 continue
             self._keys.add(key)
             frame_id, kind, ext = key
-            if kind == "can_tx" and type(frame_id) is int and 0 <= frame_id < 2**32:
+            if kind == "can_tx" and type(frame_id) is int and 0 <= frame_id < 2**32 \
+                    and frame_id not in self._python_ids:
                 lib.tm_can_key(conv, frame_id, ext, extra, len(extra))
         for frame_id, topic in list(self._signals.items()):
             cid = channels.get(topic)

@@ -75,6 +75,9 @@ def _traces(run_dir: Path, rng: random.Random) -> None:
         _can_tx(t, msgs[4], b"\x01" * 8).replace("can_tx", "can_error"),
         _can_tx(t, msgs[4], b"\x01" * 8).replace('"ext":true', '"ext":1'),
         _can_tx(t, msgs[4], b"\x01" * (codec.BY_ID[msgs[4].frame_id].length + 3)),  # too long
+        _can_tx(t, msgs[4], b"\x01" * 8).replace('"data":"0101010101010101"', '"data":null'),
+        _can_tx(t, msgs[4], b"\x01" * 8).replace(f'"id":{msgs[4].frame_id}', '"id":[1]'),
+        _can_tx(t, msgs[4], b"\x01" * 8).replace(f'"id":{msgs[4].frame_id}', '"id":"7"'),
         "not json at all", "[1,2,3]", "{}",
         _can_tx(t, msgs[5], b"\x01" * 8)[:60],                   # cut
     ]

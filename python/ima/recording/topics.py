@@ -145,6 +145,9 @@ class Topics:
                 put("/can/events", "ima.BusEvent", event_schema, t, line, i)
                 continue
             cid = r.get("id", 0)
+            if type(cid) is not int:  # a garbled identifier
+                self._skip("can.jsonl")
+                continue
             key = (cid, kind, bool(r.get("ext")))
             extra = extra_of.get(key)
             msg = by_id.get(cid) if kind == "can_tx" else None
@@ -155,11 +158,11 @@ class Topics:
                 extra = extra_of[key] = b"," + dumps(fields)[1:-1]
             # the bus's own line, with the decoded fields and its record number added
             put("/can/frames", "ima.CanFrame", schemas.CAN_FRAME, t,
-                line[:-1] + extra + b',"seq":' + str(i).encode() + b"}", i)
+                line.rstrip()[:-1] + extra + b',"seq":' + str(i).encode() + b"}", i)
             if msg is not None and not r.get("rtr"):
                 try:
                     values = msg.decode(bytes.fromhex(r.get("data", "")))
-                except (ValueError, IndexError):
+                except (ValueError, IndexError, TypeError):  # not hex, not a string
                     continue
                 topic, schema_name, schema, names = signals(msg)
                 rec = dict(zip(names, values, strict=True))

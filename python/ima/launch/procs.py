@@ -222,6 +222,15 @@ class Watch:
         self.killed: dict[str, float] = {}
         self.stopping = threading.Event()  # Ctrl-C: the processes end because they are told to
 
+    def settle(self) -> None:
+        """Once every process has ended: a node the run killed (SIGKILL, from the bus) whose
+        end this watch had no time to see, the run ending within its poll, is killed too, not
+        failed."""
+        for name, proc in self.procs.procs.items():
+            if name in self.kills and name not in self.killed \
+                    and proc.returncode == -signal.SIGKILL:
+                self.killed[name] = self.kills[name]
+
     def _expected(self, name: str, code: int | None) -> str | None:
         """The node whose death this is, if it is one the run asked for."""
         node = name.split("/")[0]

@@ -245,6 +245,8 @@ def _fly(opts, system, names, run_dir, pilot, deployed, plan, sock_dir, sock_tmp
     if ps.failed:
         raise ImaError("the run stopped early: " + "; ".join(
             f"{k} {v}" for k, v in ps.failed.items()) + f" (run directory {run_dir})")
+    if watch is not None:
+        watch.settle()
     killed = dict(watch.killed) if watch is not None else {}
     return LaunchRun(run_dir=run_dir, nodes=names, returncodes=ps.returncodes(), wall_s=wall,
                      interrupted=interrupted, killed=killed, domain=domain, hung=hung,

@@ -34,13 +34,18 @@ void canbus__client_leave(canbus_bus_t *b, canbus_client_t *c, const char *reaso
     if (c->index < 0)
         return;
     canbus_wire_attach(&b->wire, (uint8_t)c->index, false);
+    canbus__info(b, "client %d (%s) left: %s", c->index, c->name, reason);
+    /* Once the run's end is decided (a stop asked for, a signal), leaving is part of that end,
+     * not an event of the run: the trace would hold it or not depending on how soon the
+     * client went (the world asking to stop, then exiting). */
+    if (b->stopping)
+        return;
     canbus_sbuf_t *s = &c->staged;
     canbus__line_head(s, b->t, "client_leave");
     canbus__sb_client(b, s, "name", (uint8_t)c->index);
     canbus_sb_str(s, ",\"reason\":\"");
     canbus_sb_str(s, reason);
     canbus_sb_str(s, "\"}\n");
-    canbus__info(b, "client %d (%s) left: %s", c->index, c->name, reason);
 }
 
 static int enqueue(canbus_client_t *c, const void *p, size_t n)

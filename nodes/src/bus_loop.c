@@ -282,7 +282,11 @@ int canbus_bus_run(canbus_bus_t *b)
     canbus__info(b, "stopping at t=%" PRId64 " ns after %" PRIu64 " quanta, %" PRIu64 " frames",
                  b->t, b->quanta, b->wire.frames);
 
-    /* STOP to everyone, then give the queues a bounded time to drain. */
+    /* STOP to everyone, then a bounded time for the queues to drain and the lockstep members
+     * to leave. A node still in the quantum a stop came in (the world's crash, the
+     * launcher's stop) finishes it into an open socket, never into a bus already gone: what
+     * its partitions do there, and so its trace, does not depend on when the stop came. What
+     * they send now is read and dropped. */
     if (b->listen_fd >= 0) {
         close(b->listen_fd);
         b->listen_fd = -1;
@@ -291,19 +295,18 @@ int canbus_bus_run(canbus_bus_t *b)
     for (size_t i = 0; i < b->n_live; i++)
         canbus__send_stop(b, b->live[i], b->stop_reason);
     int64_t deadline = canbus__wall_ns() + 2000000000;
-    for (;;) {
-        bool any = false;
+    for (int64_t now; (now = canbus__wall_ns()) <= deadline;) {
+        bool waiting = false;
         for (size_t i = 0; i < b->n_live; i++) {
             canbus_client_t *c = b->live[i];
             if (!c->gone)
                 canbus__flush_queue(b, c);
-            if (!c->gone && canbus__queued(c))
-                any = true;
+            if (!c->gone && (canbus__queued(c) || c->member))
+                waiting = true;
         }
-        if (!any || canbus__wall_ns() > deadline)
+        if (!waiting)
             break;
-        struct timespec ts = {0, 10000000};
-        nanosleep(&ts, NULL);
+        canbus__service(b, deadline - now < 10000000 ? deadline - now : 10000000);
     }
     return rc;
 }

@@ -16,7 +16,6 @@
 #define MAX_EXTRA 256
 #define MAX_KEY 64
 #define MAX_DATA 64    /* CAN FD's largest payload */
-#define MAX_DIGITS 18  /* as trace_mcap_json.c reads them */
 #define OP_MESSAGE 0x05
 #define MSG_HEAD 31    /* opcode, record length, channel, sequence, log and publish time */
 
@@ -401,7 +400,7 @@ static int ske_line(tm_conv_t *c, const uint8_t *p, const uint8_t *end, uint64_t
     if (len < sizeof head || memcmp(p, head, sizeof head - 1) || end[-1] != '}')
         return 1;
     const uint8_t *comma = memchr(p + 8, ',', len - 8);
-    if (!comma || comma == p + 8 || (size_t)(comma - p - 8) > MAX_DIGITS)
+    if (!comma || comma == p + 8 || (size_t)(comma - p - 8) > TM_MAX_DIGITS)
         return 1;
     for (const uint8_t *q = p + 8; q < comma; q++)
         if (*q < '0' || *q > '9')

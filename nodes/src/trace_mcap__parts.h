@@ -13,6 +13,8 @@
 extern "C" {
 #endif
 
+#define TM_MAX_DIGITS 18 /* decimal integers longer than this are the Python's to read */
+
 typedef struct {
     const uint8_t *p;
     size_t n;

@@ -4,7 +4,6 @@
 
 #include "trace_mcap__parts.h"
 
-#define MAX_DIGITS 18 /* integers longer than this are the Python's to read */
 
 bool tm__eq(span_t s, const char *lit)
 {
@@ -45,7 +44,7 @@ static const uint8_t *read_value(const uint8_t *p, const uint8_t *end, value_t *
         while (p < end && *p >= '0' && *p <= '9')
             p++;
         size_t n = (size_t)(p - s);
-        if (n == 0 || n > MAX_DIGITS || (n > 1 && *s == '0'))
+        if (n == 0 || n > TM_MAX_DIGITS || (n > 1 && *s == '0'))
             return NULL;
         if (p < end && (*p == '.' || *p == 'e' || *p == 'E'))
             return NULL; /* a float: the Python's */

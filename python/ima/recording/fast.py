@@ -167,7 +167,7 @@ class CanConverter(_Converter):
         for msg in codec.BY_ID.values():
             supported = self._supported(msg)
             if lib.tm_can_message(self.conv, msg.frame_id, msg.length, 0, supported) != 0:
-                self._python_ids.add(msg.frame_id)  # too many messages for its table
+                self._python_ids.add(msg.frame_id)  # too long, or too many for its table
                 continue
             if supported:
                 for s in msg.signals:
@@ -183,10 +183,10 @@ class CanConverter(_Converter):
 
     @staticmethod
     def _supported(msg) -> bool:
+        """Whether its signals message is a plain JSON object of its signals (the C refuses
+        itself what it cannot decode: long frames, signals over 53 bits)."""
         names = msg.signal_names
-        return (bool(names) and len(set(names)) == len(names)
-                and not {"t_ns", "from"} & set(names) and msg.length <= 64
-                and all(s.length <= 53 for s in msg.signals))
+        return bool(names) and len(set(names)) == len(names) and not {"t_ns", "from"} & set(names)
 
     def learn(self) -> None:
         from ima.canbus import codec

@@ -20,12 +20,24 @@ class Follow:
     def new_lines(self) -> list[tuple[int, bytes]]:
         """(number, line without its newline) of every line completed since the last call;
         nothing while the file does not exist."""
+        return self._split(self._read(-1))
+
+    def blocks(self, size: int):
+        """Every line of a complete file, `size` bytes read at a time (a cut last line too):
+        lists of (number, line)."""
+        while data := self._read(size):
+            yield self._split(data)
+        yield self.rest()
+
+    def _read(self, size: int) -> bytes:
         if self._f is None:
             try:
                 self._f = open(self.path, "rb")  # noqa: SIM115 - closed in close()
             except OSError:
-                return []
-        data = self._f.read()
+                return b""
+        return self._f.read(size)
+
+    def _split(self, data: bytes) -> list[tuple[int, bytes]]:
         if not data:
             return []
         parts = (self._tail + data).split(b"\n")

@@ -105,8 +105,8 @@ class Topics:
             except orjson.JSONDecodeError:
                 self._skip(name)
                 continue
-            if isinstance(rec, dict) and type(rec.get("t_ns", 0)) is int \
-                    and rec.get("t_ns", 0) < 1 << 64:
+            t = rec.get("t_ns", 0) if isinstance(rec, dict) else None
+            if type(t) is int and t < 1 << 64:
                 yield i, line, rec
             else:
                 self._skip(name)

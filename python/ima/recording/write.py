@@ -20,7 +20,7 @@ import orjson
 
 from ima.errors import ImaError
 from ima.recording import fast, schemas
-from ima.recording.follow import feed_until
+from ima.recording.follow import Follow, feed_until
 
 NAME = "run.mcap"
 CHUNK_BYTES = 1 << 20
@@ -62,19 +62,12 @@ class _Out:
 def _numbered(path: Path, block: int = 1 << 22):
     """(number, line without its newline) of a trace, read a block at a time; nothing if it
     cannot be read."""
+    f = Follow(path)
     try:
-        f = open(path, "rb")  # noqa: SIM115 - closed below
-    except OSError:
-        return
-    with f:
-        n, tail = 0, b""
-        while data := f.read(block):
-            lines = (tail + data).split(b"\n")
-            tail = lines.pop()
-            yield from enumerate(lines, n)
-            n += len(lines)
-        if tail:
-            yield n, tail
+        for lines in f.blocks(block):
+            yield from lines
+    finally:
+        f.close()
 
 
 def _fdr(out: _Out, run_dir: Path, node: str) -> None:

@@ -131,15 +131,23 @@ void canbus__send_stop(canbus_bus_t *b, canbus_client_t *c, uint32_t reason)
 }
 
 /* Reads what the client has queued, up to a bound so that a flooding client cannot keep
- * the bus in here (well-behaved clients send far fewer datagrams per quantum). */
+ * the bus in here (well-behaved clients send far fewer datagrams per quantum). Up to
+ * RX_BATCH datagrams a call: a call that brings fewer found the queue empty, so a client
+ * that sent one datagram is read with one call, not two (the second saying EAGAIN). */
 void canbus__read_client(canbus_bus_t *b, canbus_client_t *c)
 {
-    c->more = true; /* until EAGAIN says otherwise */
-    for (int k = 0; k < 1024 && !c->gone; k++) {
-        struct iovec iov = {.iov_base = b->rxbuf, .iov_len = RXBUF_SIZE};
-        struct msghdr m = {.msg_iov = &iov, .msg_iovlen = 1};
-        ssize_t n = recvmsg(c->fd, &m, MSG_DONTWAIT);
-        if (n < 0) {
+    struct mmsghdr mm[RX_BATCH];
+    struct iovec iov[RX_BATCH];
+    c->more = true; /* until a short read or EAGAIN says otherwise */
+    for (int k = 0; k < 1024 && !c->gone;) {
+        int want = 1024 - k < RX_BATCH ? 1024 - k : RX_BATCH;
+        for (int j = 0; j < want; j++) {
+            iov[j] = (struct iovec){.iov_base = b->rxbuf + (size_t)j * RXBUF_SIZE,
+                                    .iov_len = RXBUF_SIZE};
+            mm[j] = (struct mmsghdr){.msg_hdr = {.msg_iov = &iov[j], .msg_iovlen = 1}};
+        }
+        int got = recvmmsg(c->fd, mm, (unsigned)want, MSG_DONTWAIT, NULL);
+        if (got < 0) {
             if (errno == EINTR)
                 continue;
             c->more = false;
@@ -147,25 +155,35 @@ void canbus__read_client(canbus_bus_t *b, canbus_client_t *c)
                 canbus__client_leave(b, c, "closed");
             return;
         }
-        if (n == 0) {
+        for (int j = 0; j < got && !c->gone; j++) {
+            uint8_t *buf = iov[j].iov_base;
+            size_t n = mm[j].msg_len;
+            bool trunc = mm[j].msg_hdr.msg_flags & MSG_TRUNC;
+            if (n == 0) {
+                c->more = false;
+                canbus__client_leave(b, c, "closed");
+                return;
+            }
+            if (c->control) { /* a truncated datagram is rejected for its size (1 byte) */
+                canbus__handle_control(b, c, buf, trunc ? 1 : n);
+                continue;
+            }
+            if (c->index < 0) {
+                canbus__handle_hello(b, c, buf, trunc ? 0 : n);
+                continue;
+            }
+            if (trunc)
+                canbus__reject(b, c, "too_long");
+            else if (n % sizeof(struct canbus_rec))
+                canbus__reject(b, c, "size");
+            else
+                canbus__handle_records(b, c, buf, n);
+        }
+        k += got;
+        if (got < want) {
             c->more = false;
-            canbus__client_leave(b, c, "closed");
             return;
         }
-        if (c->control) { /* a truncated datagram is rejected for its size (1 byte) */
-            canbus__handle_control(b, c, b->rxbuf, (m.msg_flags & MSG_TRUNC) ? 1 : (size_t)n);
-            continue;
-        }
-        if (c->index < 0) {
-            canbus__handle_hello(b, c, b->rxbuf, (m.msg_flags & MSG_TRUNC) ? 0 : (size_t)n);
-            continue;
-        }
-        if (m.msg_flags & MSG_TRUNC)
-            canbus__reject(b, c, "too_long");
-        else if (n % sizeof(struct canbus_rec))
-            canbus__reject(b, c, "size");
-        else
-            canbus__handle_records(b, c, b->rxbuf, (size_t)n);
     }
 }
 
@@ -293,8 +311,7 @@ void canbus__service(canbus_bus_t *b, int64_t timeout_ns)
  * read at most twice the bound per quantum) and those just accepted. */
 void canbus__read_all(canbus_bus_t *b)
 {
-    canbus__service(b, 0);
-    accept_all(b);
+    canbus__service(b, 0); /* accepts too, when the poll shows someone connecting */
     for (size_t i = 0; i < b->n_live; i++)
         if (!b->live[i]->gone && b->live[i]->more)
             canbus__read_client(b, b->live[i]);

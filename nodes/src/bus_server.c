@@ -27,7 +27,7 @@ int canbus_bus_open(canbus_bus_t *b, const canbus_opts_t *o)
     for (size_t i = 0; i < o->n_faults; i++)
         if ((rc = canbus_wire_add_fault(&b->wire, &o->faults[i].fault)))
             goto fail_wire;
-    b->rxbuf = malloc(RXBUF_SIZE);
+    b->rxbuf = malloc((size_t)RX_BATCH * RXBUF_SIZE);
     if (!b->rxbuf) {
         rc = -ENOMEM;
         goto fail_wire;

@@ -12,6 +12,7 @@
 #include "canbus__bus.h"
 
 #define RXBUF_SIZE (CANBUS_MAX_RECS * sizeof(struct canbus_rec) + 64)
+#define RX_BATCH 8 /* datagrams read by one call (canbus__read_client()); rxbuf holds as many */
 
 /* ---- bus_trace.c: trace lines and messages ---------------------------------------------- */
 

@@ -180,6 +180,7 @@ class Actuators:
         # Set by the fault injectors (faults.py): per actuator None, ("jam", position, 0) or
         # ("drive", position, rate): the actuator goes there at that rate, whatever the command.
         self.override: list | None = None
+        self._moves: tuple = (None, ())  # (dt, each actuator's largest move in dt): step()
 
     def rate(self, i: int) -> float:
         """Actuator i's rate limit (normalised units per second)."""
@@ -230,10 +231,15 @@ class Actuators:
     def step(self, now_ns: int, dt_s: float) -> list[float]:
         """Move every actuator toward its target for one physics step starting at now_ns."""
         target = self._target(now_ns)
-        p = self.p
         pos, lo, hi = self.pos, self.lo, self.hi
         ov = self.override
-        for i in range(4):
+        moves = self._moves
+        if moves[0] != dt_s:
+            p = self.p
+            # the most each one moves in a step: (rate * dt), as computed below with an override
+            moves = self._moves = (dt_s, tuple((p.throttle_rate if i == 3 else p.surface_rate)
+                                               * dt_s for i in range(4)))
+        for i, m in enumerate(moves[1]):
             tgt = target[i]
             if tgt < lo[i]:
                 tgt = lo[i]
@@ -242,8 +248,6 @@ class Actuators:
             if ov is not None and ov[i] is not None:
                 tgt, rate = ov[i][1], ov[i][2]  # a faulty actuator: the command does not count
                 m = rate * dt_s
-            else:
-                m = (p.throttle_rate if i == 3 else p.surface_rate) * dt_s
             d = tgt - pos[i]
             if d > m:
                 d = m

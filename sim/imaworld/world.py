@@ -44,6 +44,12 @@ _NAV_DATA = {MESSAGES[f"NAV_DATA_{c}"].frame_id: (i, MESSAGES[f"NAV_DATA_{c}"].d
              for i, c in enumerate(CHANNELS)}
 _BRAKE_CMD = {MESSAGES[f"BRAKE_CMD_{c}"].frame_id: (i, MESSAGES[f"BRAKE_CMD_{c}"].decode)
               for i, c in enumerate(CHANNELS)}
+# What the world does with a frame it receives, by identifier: (kind, channel, decode).
+_ACT, _BRAKE, _STATUS, _POS, _DATA = range(5)
+_HANDLED = {fid: (kind, *v) for kind, table in ((_ACT, _ACT_CMD), (_BRAKE, _BRAKE_CMD),
+                                                (_STATUS, _FCS_STATUS), (_POS, _NAV_POS),
+                                                (_DATA, _NAV_DATA))
+            for fid, v in table.items()}
 NEAR_GROUND_FT = 15.0  # below this height (of the centre of gravity) the wheels are watched
 # The world leaves the quanta before its next task ungranted (World._delivered) only this far
 # from every limit a crash is judged by, and for SKIP_MAX_NS at most: no aircraft gets from
@@ -91,6 +97,16 @@ def _r(x: float, n: int) -> float | None:
         return None
     v = round(x, n)
     return 0.0 if v == 0 else v  # no "-0.0"
+
+
+def _named(counts: dict[int, int]) -> dict[str, int]:
+    """Frame counts by identifier, by name (the DBC's, else the identifier in hex)."""
+    out: dict[str, int] = {}
+    for fid, n in counts.items():
+        m = BY_ID.get(fid)
+        name = m.name if m is not None else f"0x{fid:08x}"
+        out[name] = out.get(name, 0) + n
+    return dict(sorted(out.items()))
 
 
 class World:
@@ -151,8 +167,8 @@ class World:
         self.n = 0  # physics steps done: the state is at t_n = n * NS // hz
         self.next_step_t = NS // self.hz
         self.t_now = 0
-        self.sent: dict[str, int] = {}
-        self.received: dict[str, int] = {}
+        self.sent: dict[int, int] = {}  # frames by identifier (named in world.json)
+        self.received: dict[int, int] = {}
         self.crash: tuple[int, str] | None = None
         self.stop_reason: str | None = None
         self.interrupted = False  # set by a signal: stop at the end of the quantum
@@ -197,8 +213,7 @@ class World:
         send, sent = self.bus.send, self.sent
         for fid, data in frames:
             send(fid, data, t_ns)
-            name = BY_ID[fid].name
-            sent[name] = sent.get(name, 0) + 1
+            sent[fid] = sent.get(fid, 0) + 1
 
     def fcs_mode(self) -> tuple[str | None, str | None]:
         """What the station shows: the lowest FCS channel heard recently, else the last heard."""
@@ -415,41 +430,35 @@ class World:
         rcv = self.received
         link_up = self.link_up()
         pm = self.pilot_model if self.pilot_model.enabled else None
+        handled = _HANDLED
         for f in frames:
             fid = f.id
-            m = BY_ID.get(fid)
-            name = m.name if m is not None else f"0x{fid:08x}"
-            rcv[name] = rcv.get(name, 0) + 1
-            a = _ACT_CMD.get(fid)
-            if a is not None:
-                e, ai, ru, th, _cnt = a[1](f.data)
-                self.act.command(a[0], f.t_ns, (e, ai, ru, th))
+            rcv[fid] = rcv.get(fid, 0) + 1
+            h = handled.get(fid)
+            if h is None:
                 continue
-            b = _BRAKE_CMD.get(fid)
-            if b is not None:
-                self.ground.brake_command(b[0], f.t_ns, b[1](f.data)[0])
+            kind, ch, decode = h
+            if kind == _ACT:
+                e, ai, ru, th, _cnt = decode(f.data)
+                self.act.command(ch, f.t_ns, (e, ai, ru, th))
+            elif kind == _BRAKE:
+                self.ground.brake_command(ch, f.t_ns, decode(f.data)[0])
+            elif not link_up:
                 continue
-            if not link_up:
-                continue
-            s = _FCS_STATUS.get(fid)
-            if s is not None:
-                v = s[1](f.data)
-                self.fcs_status[s[0]] = (f.t_ns, v[0], v[2])
+            elif kind == _STATUS:
+                v = decode(f.data)
+                self.fcs_status[ch] = (f.t_ns, v[0], v[2])
                 self.fcs_last = (v[0], v[2])
                 if pm is not None:
-                    pm.status(s[0], f.t_ns, v[0], v[2], v[3], v[8], v[9])
+                    pm.status(ch, f.t_ns, v[0], v[2], v[3], v[8], v[9])
+            elif pm is None:
                 continue
-            if pm is None:
-                continue
-            n = _NAV_POS.get(fid)
-            if n is not None:
-                lat, lon = n[1](f.data)
-                pm.nav_pos(n[0], f.t_ns, lat, lon)
-                continue
-            n = _NAV_DATA.get(fid)
-            if n is not None:
-                alt, wdir, wspd, _gs = n[1](f.data)
-                pm.nav_data(n[0], f.t_ns, alt, wdir, wspd)
+            elif kind == _POS:
+                lat, lon = decode(f.data)
+                pm.nav_pos(ch, f.t_ns, lat, lon)
+            else:
+                alt, wdir, wspd, _gs = decode(f.data)
+                pm.nav_data(ch, f.t_ns, alt, wdir, wspd)
 
     # -- physics -------------------------------------------------------------------------
     def advance(self, t: int) -> None:
@@ -459,12 +468,13 @@ class World:
         ac, act, g = self.ac, self.act, self.ac.get
         run, set_controls, dt, hz = ac.run, ac.set_controls, self.dt, self.hz
         lim = self.p.limits
+        max_roll, max_cas, max_load = lim.max_roll_deg, lim.max_cas_kt, lim.max_load_g
         agl, phi, cas, nz = g["agl"], g["phi"], g["cas"], g["nz"]
         ground = self.ground
+        step = act.step
         n = self.n
         while self.next_step_t <= t:
-            t_n = n * NS // hz
-            pos = act.step(t_n, dt)
+            pos = step(n * NS // hz, dt)
             set_controls(pos[0], pos[1], pos[2], pos[3])
             run()
             n += 1
@@ -472,15 +482,15 @@ class World:
             self.n = n
             self.t_now = n * NS // hz
             a, r = agl(), phi()
-            if not a > 0.0 or not -lim.max_roll_deg <= r <= lim.max_roll_deg:
+            if not a > 0.0 or not -max_roll <= r <= max_roll:
                 if a != a or r != r:
                     self._crash("state is not a number")
                 self._crash("ground contact" if a <= 0.0 else f"roll {r:.1f} deg")
             c, z = cas(), nz()
             # the load factor counts in the air: on the wheels the gear's springs give spikes
-            on_wheels = ground.touchdown is not None and a < NEAR_GROUND_FT
-            if not c <= lim.max_cas_kt or not (abs(z) <= lim.max_load_g or on_wheels):
-                self._crash(f"airspeed {c:.1f} kt" if not c <= lim.max_cas_kt
+            if not c <= max_cas or not (abs(z) <= max_load
+                                        or (ground.touchdown is not None and a < NEAR_GROUND_FT)):
+                self._crash(f"airspeed {c:.1f} kt" if not c <= max_cas
                             else f"load factor {z:.1f} g")
             if a < NEAR_GROUND_FT:
                 self._near_ground(ground, a, r, pos, dt)
@@ -570,7 +580,7 @@ class World:
     def run(self) -> int:
         bus = self.bus
         tasks = self._tasks
-        next_due = min(tk[0] for tk in tasks)
+        next_due = min([tk[0] for tk in tasks])
         next_flush = FLUSH_EVERY_NS
         # the quantum of a bus that grants only the quanta asked for (ima-canbus; not the
         # unit tests' in-process stand-in): 0, every quantum
@@ -599,7 +609,7 @@ class World:
                         if tk[0] == s:
                             tk[2](s)
                             tk[0] = tk[3]() if tk[1] == 0 else s + tk[1]
-                    next_due = min(tk[0] for tk in tasks)
+                    next_due = min([tk[0] for tk in tasks])
                 self.advance(t_until)
                 self.t_end = t_until
                 if q and self._far_from_the_limits():
@@ -670,8 +680,8 @@ class World:
             "t_end_ns": self.t_end,
             "steps": self.n,
             "final": final,
-            "frames_sent": dict(sorted(self.sent.items())),
-            "frames_received": dict(sorted(self.received.items())),
+            "frames_sent": _named(self.sent),
+            "frames_received": _named(self.received),
             "channels": self.opts.channels or 1,
             "vote": self._vote_summary(),
         }

@@ -12,16 +12,18 @@ from ima.flight.summary import HoldSegment
 def plot_flight(truth: list[dict], segments: list[HoldSegment], out: Path, title: str,
                 events: list[tuple[float, str]] | None = None) -> Path:
     """`events`: (time s, label) marked on every panel, e.g. a node killed, a replica voted out."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    # A figure and its canvas directly: a file needs none of pyplot's figure management.
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
     t = [r["t_ns"] / 1e9 for r in truth]
-    panels = [("alt_ft", "altitude (ft)", "altitude_ft"), ("airspeed_kt", "airspeed (kt)", "airspeed_kt"),
+    panels = [("alt_ft", "altitude (ft)", "altitude_ft"),
+              ("airspeed_kt", "airspeed (kt)", "airspeed_kt"),
               ("heading_deg", "heading (°)", "heading_deg"), ("roll_deg", "bank (°)", None)]
-    fig, axes = plt.subplots(len(panels), 1, figsize=(10, 9), sharex=True)
-    for ax, (key, label, target) in zip(axes, panels):
+    fig = Figure(figsize=(10, 9))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(panels), 1, sharex=True)
+    for ax, (key, label, target) in zip(axes, panels, strict=True):
         ax.plot(t, [r[key] for r in truth], lw=0.8, color="tab:blue", label="truth")
         for k, seg in enumerate(segments):
             ax.axvspan(seg.t0_s, seg.t1_s, color="tab:green", alpha=0.08,
@@ -48,7 +50,7 @@ def plot_flight(truth: list[dict], segments: list[HoldSegment], out: Path, title
     axes[0].legend(loc="upper left", fontsize=8)
     axes[-1].set_xlabel("emulated time (s)")
     fig.suptitle(title)
-    fig.tight_layout()
+    # fixed margins: tight_layout would draw the whole figure once more to measure it
+    fig.subplots_adjust(left=0.085, right=0.985, top=0.94, bottom=0.065, hspace=0.12)
     fig.savefig(out, dpi=90)
-    plt.close(fig)
     return out

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import socket
 import subprocess
 import threading
@@ -203,3 +204,50 @@ def test_a_client_that_stops_reading_is_queued_for_then_dropped(tmp_path):
     assert [(e["name"], e["reason"]) for e in leaves
             if e["name"] in ("slow", "late")] == [("slow", "send_timeout")], leaves
     assert late_frames == [0x100 + k % 0x400 for k in range(sent)]
+
+
+def test_many_datagrams_in_one_quantum_are_all_read_in_order(tmp_path):
+    """The bus reads a client's datagrams several at a time: 21 of them waiting at once (sent
+    while the bus is stopped; a bad one among them, rejected alone), then the DONE, put 20
+    frames on the wire in the order sent, all in that quantum; a client joining later is still
+    accepted."""
+    sock, trace, stats = tmp_path / "can.sock", tmp_path / "can.jsonl", tmp_path / "can.json"
+    bus = subprocess.Popen([str(BUS), "--socket", str(sock), "--lockstep-clients", "1",
+                            "--trace", str(trace), "--stats", str(stats), "-q"],
+                           stderr=subprocess.PIPE, text=True)
+    clients = []
+    try:
+        node, _ = _join(sock, "node1", proto.ROLE_CAN | proto.ROLE_LOCKSTEP)
+        clients.append(node)
+        chatty, _ = _join(sock, "chatty", proto.ROLE_CAN)
+        clients.append(chatty)
+        t_next = _next_tick(node)
+        bus.send_signal(signal.SIGSTOP)  # all of them waiting when the bus looks
+        try:
+            for k in range(20):
+                chatty.send(proto.pack_frame(0x200 + k, bytes([k]), t_next, extended=False))
+                if k == 9:
+                    chatty.send(b"\x00" * 33)  # not a whole number of records
+            node.send(proto.pack_rec(proto.MSG_DONE, t_ns=t_next))
+        finally:
+            bus.send_signal(signal.SIGCONT)
+        t_next = _next_tick(node)
+        later, answer = _join(sock, "later", proto.ROLE_CAN)
+        clients.append(later)
+        assert len(answer) == proto.WELCOME_SIZE
+        for _ in range(10):  # time enough for the 20 frames on the wire
+            node.send(proto.pack_rec(proto.MSG_DONE, t_ns=t_next))
+            t_next = _next_tick(node)
+        node.send(proto.pack_rec(proto.MSG_STOP, id_=proto.STOP_REQUESTED))
+        assert bus.wait(timeout=30) == 0, bus.stderr.read()
+    finally:
+        _close(bus, clients)
+    lines = [json.loads(line) for line in trace.read_text().splitlines()]
+    sent = [e["id"] for e in lines if e["kind"] == "can_tx" and e["from"] == "chatty"]
+    assert sent == [0x200 + k for k in range(20)], sent
+    # all read in the quantum they were sent in: on the wire back to back from its start
+    wire = [(e["start_ns"], e["t_ns"]) for e in lines if e["kind"] == "can_tx"]
+    assert [a for a, _ in wire] == [0] + [b for _, b in wire[:-1]], wire
+    rejects = [(e.get("name"), e["reason"]) for e in lines if e["kind"] == "reject"]
+    assert rejects == [("chatty", "size")], rejects
+    assert "later" in [e.get("name") for e in lines if e["kind"] == "client_join"]

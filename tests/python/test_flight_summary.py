@@ -46,3 +46,47 @@ def test_tracking_errors_wrap_heading_and_use_only_segments():
 
 def test_wrap180():
     assert summary.wrap180(190) == -170 and summary.wrap180(-190) == 170
+
+
+def test_a_window_kept_past_its_cpu_budget_without_a_fault_is_told_as_a_host_stall(tmp_path):
+    """The summary lists the windows the SKE stopped at their CPU budget (one reading of each
+    node's trace, with its HM events); the launch names those of partitions no fault acts on,
+    and its report warns of them."""
+    import io
+
+    from rich.console import Console
+
+    from ima.launch import report
+    from ima.launch.summary import host_stalls
+
+    lines = [
+        {"t_ns": 1, "node": "node1", "src": "ske", "kind": "window_start", "partition": "io"},
+        {"t_ns": 312_400_000_000, "node": "node1", "src": "ske", "kind": "overrun",
+         "partition": "io", "window": 0, "frame": 6248, "budget_ns": 4_000_000,
+         "cause": "cpu_budget", "action": "stopped"},
+        {"t_ns": 312_400_000_000, "node": "node1", "src": "ske", "kind": "overrun",
+         "partition": "fdr", "window": 3, "frame": 6248, "cause": "outside_window",
+         "action": "reported"},
+        {"t_ns": 312_404_000_000, "node": "node1", "src": "ske", "kind": "hm",
+         "partition": "io", "error": "WINDOW_OVERRUN", "level": "PARTITION", "action": "IGNORE"},
+    ]
+    trace = tmp_path / "node1.jsonl"
+    trace.write_text("".join(json.dumps(x) + "\n" for x in lines) + '{"cut')
+    hm, overruns = summary.node_events(trace)
+    assert [e["error"] for e in hm] == ["WINDOW_OVERRUN"]
+    assert overruns == [{"t_ns": 312_400_000_000, "partition": "io", "window": 0,
+                         "budget_ns": 4_000_000}]  # the cause outside_window is not one
+    cpu = [dict(o, node="node1") for o in overruns]
+    assert host_stalls(cpu, set()) == cpu
+    assert host_stalls(cpu, {("node1", "io")}) == []  # a fault on it explains it
+    assert host_stalls(cpu, {("node1", None)}) == []  # so does one on the whole node
+    assert host_stalls(cpu, {("node2", "io"), ("node1", "fdr")}) == cpu
+
+    out = io.StringIO()
+    report._print_host_stalls(cpu + cpu, Console(file=out, width=200))
+    text = out.getvalue()
+    assert "node1/io kept a window past its CPU budget at 312.400 s (and 1 more)" in text
+    assert "host stalled it" in text
+    out = io.StringIO()
+    report._print_host_stalls([], Console(file=out, width=200))
+    assert out.getvalue() == ""

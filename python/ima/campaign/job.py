@@ -38,14 +38,14 @@ def options(campaign: dict, run: dict, run_dir: Path, faults: list) -> LaunchOpt
             campaign.get("test_switches") or []))
 
 
-def host_stalls(traces, targets: set[tuple[str, str]]) -> list[dict]:
-    """CPU-budget overruns of partitions that are not targets of a fault: the RPAS partitions
-    use a tiny part of their budgets, so one that overran was stalled by the host (a preempted
-    virtual CPU, direct reclaim), not by anything under test."""
-    return [dict(e, node=node) for node in traces.nodes
-            for e in traces.node_kind(node, "overrun")
-            if e.get("cause") == "cpu_budget" and (node, e.get("partition")) not in targets
-            and (node, None) not in targets]
+def host_stalls(traces, targets: set[tuple[str, str | None]]) -> list[dict]:
+    """CPU-budget overruns of partitions that are not targets of a fault (see
+    ima.launch.summary.host_stalls)."""
+    from ima.launch.summary import host_stalls as stalls
+
+    return stalls([dict(e, node=node) for node in traces.nodes
+                   for e in traces.node_kind(node, "overrun") if e.get("cause") == "cpu_budget"],
+                  targets)
 
 
 @functools.lru_cache(maxsize=4)
@@ -69,10 +69,10 @@ def run_one(campaign: dict, run: dict, run_dir: Path | None = None) -> dict:
     runs/RUN_ID); returns its record (results.jsonl)."""
     from faultinject import grammar
     from faultinject.judge import judge
-    from faultinject.oracles import direct_targets
     from faultinject.traces import RunTraces
     from ima import provenance
     from ima.launch import run as launch_run
+    from ima.launch import summary as launch_summary
 
     t0 = time.monotonic()
     cdir = Path(campaign["dir"])
@@ -93,8 +93,7 @@ def run_one(campaign: dict, run: dict, run_dir: Path | None = None) -> dict:
         flight_wall += result.wall_s
         if result.interrupted:
             raise KeyboardInterrupt(f"{run['run_id']} interrupted")
-        targets = {t for inj in result.plan.injections for t in direct_targets(inj)} \
-            if result.plan else set()
+        targets = launch_summary.fault_targets(result.plan)
         traces = RunTraces(run_dir)  # read once: the stalls, the judgement, the HM
         stalls = host_stalls(traces, targets)
         if not stalls or refly >= 2:

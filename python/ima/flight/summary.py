@@ -51,17 +51,18 @@ def hold_segments(pilot_yaml: Path, duration_s: float) -> list[HoldSegment]:
     return segments
 
 
-def read_jsonl(path: Path, needle: str | None = None) -> Iterator[dict]:
-    """The JSON objects of a JSON-lines file; with `needle`, only those of the lines that
-    contain it (the others are not parsed: a node's trace is 200,000 lines an hour of which a
-    summary wants a handful)."""
+def read_jsonl(path: Path, needle: str | tuple[str, ...] | None = None) -> Iterator[dict]:
+    """The JSON objects of a JSON-lines file; with `needle` (one string or several), only those
+    of the lines that contain it (the others are not parsed: a node's trace is 200,000 lines an
+    hour of which a summary wants a handful)."""
     try:
         f = path.open(encoding="utf-8")
     except FileNotFoundError:
         return
+    needles = (needle,) if isinstance(needle, str) else needle
     with f:
         for line in f:
-            if needle is not None and needle not in line:
+            if needles is not None and not any(n in line for n in needles):
                 continue
             line = line.strip()
             if not line:
@@ -145,8 +146,21 @@ def _name(names: dict[int, str], v: Any) -> Any:
 
 
 def hm_events(node_trace: Path) -> list[dict]:
-    return [{k: rec.get(k) for k in ("t_ns", "partition", "error", "level", "action", "process")}
-            for rec in read_jsonl(node_trace, needle='"hm"') if rec.get("kind") == "hm"]
+    return node_events(node_trace)[0]
+
+
+def node_events(node_trace: Path) -> tuple[list[dict], list[dict]]:
+    """A node's health-monitor events, and the windows its partitions kept past their CPU
+    budget (the SKE's `overrun` events of cause `cpu_budget`), in one reading of its trace."""
+    hm, overruns = [], []
+    for rec in read_jsonl(node_trace, needle=('"hm"', '"overrun"')):
+        kind = rec.get("kind")
+        if kind == "hm":
+            hm.append({k: rec.get(k)
+                       for k in ("t_ns", "partition", "error", "level", "action", "process")})
+        elif kind == "overrun" and rec.get("cause") == "cpu_budget":
+            overruns.append({k: rec.get(k) for k in ("t_ns", "partition", "window", "budget_ns")})
+    return hm, overruns
 
 
 def summarise(run_dir: Path, pilot: Path, duration_s: float, wall_s: float | None = None,
@@ -173,12 +187,14 @@ def summarise(run_dir: Path, pilot: Path, duration_s: float, wall_s: float | Non
         {"t0_s": s.t0_s, "t1_s": s.t1_s, "heading_deg": s.heading_deg,
          "altitude_ft": s.altitude_ft, "airspeed_kt": s.airspeed_kt} for s in segments]
     summary["mode_changes"] = mode_changes(truth)
-    hm = []
+    hm, overruns = [], []
     for k in range(1, nodes + 1):
-        for ev in hm_events(run_dir / f"node{k}.jsonl"):
-            hm.append(dict(ev, node=f"node{k}"))
+        node_hm, node_overruns = node_events(run_dir / f"node{k}.jsonl")
+        hm += [dict(ev, node=f"node{k}") for ev in node_hm]
+        overruns += [dict(ev, node=f"node{k}") for ev in node_overruns]
     summary["hm_events"] = len(hm)
     summary["hm_event_list"] = hm[:50]
+    summary["cpu_overruns"] = sorted(overruns, key=lambda e: (e["t_ns"] or 0, e["node"]))[:50]
     summary["bus_load"] = bus.get("load")
     summary["bus_load_max_1s"] = bus.get("load_max_1s")
     summary["can_frames"] = bus.get("frames")

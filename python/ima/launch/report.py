@@ -41,6 +41,21 @@ def print_flight(s: dict, console) -> None:
     for ev in s["hm_event_list"][:5]:
         console.print(f"  {ev['t_ns'] / 1e9:9.3f} s {ev['node']}/{ev.get('partition')}: "
                       f"{ev.get('error')} → {ev.get('action')}", markup=False)
+    _print_host_stalls(s.get("host_stalls") or [], console)
+
+
+def _print_host_stalls(stalls: list[dict], console) -> None:
+    """Windows kept past their CPU budget by partitions no fault acts on (host_stalls)."""
+    if not stalls:
+        return
+    first = stalls[0]
+    more = f" (and {len(stalls) - 1} more)" if len(stalls) > 1 else ""
+    console.print(f"Warning: {first['node']}/{first['partition']} kept a window past its CPU "
+                  f"budget at {first['t_ns'] / 1e9:.3f} s{more} with no fault on it. The RPAS "
+                  "partitions use a small part of their budgets: the host stalled it (a "
+                  "preempted virtual CPU, memory reclaim), and from there this flight is not "
+                  "the one a quiet host flies. Fly it again to compare.",
+                  style="yellow", markup=False)
 
 
 def _pair(a, b, d: int = 1, sep: str = " / ") -> str:

@@ -115,6 +115,25 @@ def dds_refused(dds: dict[str, dict]) -> list[dict]:
     return out
 
 
+def fault_targets(plan) -> set[tuple[str, str | None]]:
+    """(node, partition) a run's faults (its FaultPlan, or None) act on directly; partition
+    None: the whole node."""
+    if plan is None:
+        return set()
+    from faultinject.oracles import direct_targets
+
+    return {t for inj in plan.injections for t in direct_targets(inj)}
+
+
+def host_stalls(overruns: list[dict], targets: set[tuple[str, str | None]]) -> list[dict]:
+    """The CPU-budget overruns (`cpu_overruns`) of partitions no fault acts on (`targets`:
+    (node, partition), partition None for a whole node). The RPAS partitions use a small part
+    of their budgets: one that overran was stalled by the host (a preempted virtual CPU, memory
+    reclaim), not by anything in the run, and the flight from there is not a quiet host's."""
+    return [o for o in overruns if (o["node"], o.get("partition")) not in targets
+            and (o["node"], None) not in targets]
+
+
 def summarise(run_dir: Path, pilot: Path, duration_s: float, nodes: list[str],
               killed: dict[str, float], wall_s: float | None = None,
               plot: bool = False, hung: dict[str, float] | None = None) -> dict[str, Any]:

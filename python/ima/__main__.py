@@ -3,4 +3,4 @@
 
 from ima.cli import main
 
-raise SystemExit(main())
+raise SystemExit(main(exit_process=True))

@@ -159,6 +159,10 @@ def add_run_arguments(parser: argparse.ArgumentParser, kind: str = "launch") -> 
                         "(root only), so that a node can really be cut off the network")
 
 
+# Once the summary is out, the process ends without the interpreter's teardown (ima.cli.main).
+FAST_EXIT = True
+
+
 def add_parser(subparsers) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         "launch",

@@ -132,15 +132,18 @@ void canbus__send_stop(canbus_bus_t *b, canbus_client_t *c, uint32_t reason)
 
 /* Reads what the client has queued, up to a bound so that a flooding client cannot keep
  * the bus in here (well-behaved clients send far fewer datagrams per quantum). Up to
- * RX_BATCH datagrams a call: a call that brings fewer found the queue empty, so a client
- * that sent one datagram is read with one call, not two (the second saying EAGAIN). */
+ * RX_BATCH datagrams a call: a call that brings fewer than it asked for found the queue
+ * empty, so a client that sent one datagram is read with one call, not two (the second
+ * saying EAGAIN). */
 void canbus__read_client(canbus_bus_t *b, canbus_client_t *c)
 {
     struct mmsghdr mm[RX_BATCH];
     struct iovec iov[RX_BATCH];
     c->more = true; /* until a short read or EAGAIN says otherwise */
     for (int k = 0; k < 1024 && !c->gone;) {
-        int want = 1024 - k < RX_BATCH ? 1024 - k : RX_BATCH;
+        /* A client not yet welcomed is read a datagram at a time: handling its HELLO may read
+         * other clients (canbus__handle_hello()), into the same buffer. */
+        int want = c->index < 0 ? 1 : 1024 - k < RX_BATCH ? 1024 - k : RX_BATCH;
         for (int j = 0; j < want; j++) {
             iov[j] = (struct iovec){.iov_base = b->rxbuf + (size_t)j * RXBUF_SIZE,
                                     .iov_len = RXBUF_SIZE};

@@ -54,8 +54,12 @@ def main(argv: Sequence[str] | None = None, exit_process: bool = False) -> int:
         for stream in (sys.stdout, sys.stderr):
             try:
                 stream.flush()
-            except (OSError, ValueError):
+            except ValueError:  # closed
                 pass
+            except BrokenPipeError:  # the reader went away, as in _run()
+                code = code or 141
+            except OSError:  # what was written is lost (a full disk): as Python says so, 120
+                code = code or 120
         os._exit(code)
     return code
 

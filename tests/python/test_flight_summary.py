@@ -57,7 +57,6 @@ def test_a_window_kept_past_its_cpu_budget_without_a_fault_is_told_as_a_host_sta
     from rich.console import Console
 
     from ima.launch import report
-    from ima.launch.summary import host_stalls
 
     lines = [
         {"t_ns": 1, "node": "node1", "src": "ske", "kind": "window_start", "partition": "io"},
@@ -77,16 +76,27 @@ def test_a_window_kept_past_its_cpu_budget_without_a_fault_is_told_as_a_host_sta
     assert overruns == [{"t_ns": 312_400_000_000, "partition": "io", "window": 0,
                          "budget_ns": 4_000_000}]  # the cause outside_window is not one
     cpu = [dict(o, node="node1") for o in overruns]
+    host_stalls = summary.host_stalls
     assert host_stalls(cpu, set()) == cpu
     assert host_stalls(cpu, {("node1", "io")}) == []  # a fault on it explains it
     assert host_stalls(cpu, {("node1", None)}) == []  # so does one on the whole node
     assert host_stalls(cpu, {("node2", "io"), ("node1", "fdr")}) == cpu
 
     out = io.StringIO()
-    report._print_host_stalls(cpu + cpu, Console(file=out, width=200))
+    report._print_host_stalls(cpu + cpu, 70, Console(file=out, width=200))  # 50 of 70 listed
     text = out.getvalue()
-    assert "node1/io kept a window past its CPU budget at 312.400 s (and 1 more)" in text
+    assert "node1/io kept a window past its CPU budget at 312.400 s (and 69 more)" in text
     assert "host stalled it" in text
     out = io.StringIO()
-    report._print_host_stalls([], Console(file=out, width=200))
+    report._print_host_stalls([], 0, Console(file=out, width=200))
     assert out.getvalue() == ""
+
+    # In a flight's summary: every overrun counted, the first 50 listed, stalls among all
+    (tmp_path / "truth.jsonl").write_text(json.dumps({"t_ns": 0, "alt_ft": 3000}) + "\n")
+    faulty = {"t_ns": 1, "node": "node1", "src": "ske", "kind": "overrun", "partition": "fdr",
+              "window": 3, "budget_ns": 1, "cause": "cpu_budget", "action": "stopped"}
+    trace.write_text("".join(json.dumps(dict(faulty, t_ns=k)) + "\n" for k in range(60))
+                     + "".join(json.dumps(x) + "\n" for x in lines))
+    s = summary.summarise(tmp_path, _script(tmp_path, []), 1.0, fault_targets={("node1", "fdr")})
+    assert (s["cpu_overrun_count"], len(s["cpu_overruns"])) == (61, 50)
+    assert s["host_stall_count"] == 1 and s["host_stalls"][0]["partition"] == "io"

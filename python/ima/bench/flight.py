@@ -110,7 +110,7 @@ def fly_once(system: Path, duration_s: float, seed: int, console, cpu: int | Non
             "wall_s": round(wall, 2), "speedup": round(flown / wall, 1),
             "peak_rss_mb": round(sampler.peak / 2**20, 1),
             "cpu_ms_per_emulated_s": cpu_sampler.per_emulated_s(cpu_s, flown),
-            "truth_sha256": sha, "host_stalls": len(summary.get("host_stalls") or [])}
+            "truth_sha256": sha, "host_stalls": summary.get("host_stall_count") or 0}
 
 
 def _partitions_cpu_s(run_dir: Path) -> dict[str, float]:

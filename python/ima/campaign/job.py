@@ -40,8 +40,8 @@ def options(campaign: dict, run: dict, run_dir: Path, faults: list) -> LaunchOpt
 
 def host_stalls(traces, targets: set[tuple[str, str | None]]) -> list[dict]:
     """CPU-budget overruns of partitions that are not targets of a fault (see
-    ima.launch.summary.host_stalls)."""
-    from ima.launch.summary import host_stalls as stalls
+    ima.flight.summary.host_stalls)."""
+    from ima.flight.summary import host_stalls as stalls
 
     return stalls([dict(e, node=node) for node in traces.nodes
                    for e in traces.node_kind(node, "overrun") if e.get("cause") == "cpu_budget"],

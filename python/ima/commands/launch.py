@@ -261,9 +261,8 @@ def launch_and_summarise(opts: launch_options.LaunchOptions, json_out: bool,
     recording.flown(recorder)  # it reads what is left while we summarise
     summary = launch_summary.summarise(result.run_dir, pilot, opts.duration_s, result.nodes,
                                        result.killed, result.wall_s, plot=True,
-                                       hung=result.hung)
-    summary["host_stalls"] = launch_summary.host_stalls(summary["cpu_overruns"],
-                                                        launch_summary.fault_targets(result.plan))
+                                       hung=result.hung,
+                                       fault_targets=launch_summary.fault_targets(result.plan))
     if opts.mission is not None:
         from ima.mission import flown
         from ima.mission import plan as mission_plan

@@ -41,15 +41,17 @@ def print_flight(s: dict, console) -> None:
     for ev in s["hm_event_list"][:5]:
         console.print(f"  {ev['t_ns'] / 1e9:9.3f} s {ev['node']}/{ev.get('partition')}: "
                       f"{ev.get('error')} → {ev.get('action')}", markup=False)
-    _print_host_stalls(s.get("host_stalls") or [], console)
+    _print_host_stalls(s.get("host_stalls") or [], s.get("host_stall_count"), console)
 
 
-def _print_host_stalls(stalls: list[dict], console) -> None:
-    """Windows kept past their CPU budget by partitions no fault acts on (host_stalls)."""
+def _print_host_stalls(stalls: list[dict], count: int | None, console) -> None:
+    """Windows kept past their CPU budget by partitions no fault acts on (host_stalls, of
+    which there are `count`)."""
     if not stalls:
         return
     first = stalls[0]
-    more = f" (and {len(stalls) - 1} more)" if len(stalls) > 1 else ""
+    n = max(count or 0, len(stalls))
+    more = f" (and {n - 1} more)" if n > 1 else ""
     console.print(f"Warning: {first['node']}/{first['partition']} kept a window past its CPU "
                   f"budget at {first['t_ns'] / 1e9:.3f} s{more} with no fault on it. The RPAS "
                   "partitions use a small part of their budgets: the host stalled it (a "

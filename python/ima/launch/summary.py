@@ -125,26 +125,20 @@ def fault_targets(plan) -> set[tuple[str, str | None]]:
     return {t for inj in plan.injections for t in direct_targets(inj)}
 
 
-def host_stalls(overruns: list[dict], targets: set[tuple[str, str | None]]) -> list[dict]:
-    """The CPU-budget overruns (`cpu_overruns`) of partitions no fault acts on (`targets`:
-    (node, partition), partition None for a whole node). The RPAS partitions use a small part
-    of their budgets: one that overran was stalled by the host (a preempted virtual CPU, memory
-    reclaim), not by anything in the run, and the flight from there is not a quiet host's."""
-    return [o for o in overruns if (o["node"], o.get("partition")) not in targets
-            and (o["node"], None) not in targets]
-
-
 def summarise(run_dir: Path, pilot: Path, duration_s: float, nodes: list[str],
               killed: dict[str, float], wall_s: float | None = None,
-              plot: bool = False, hung: dict[str, float] | None = None) -> dict[str, Any]:
-    """The run's summary (also written to RUN_DIR/summary.json)."""
+              plot: bool = False, hung: dict[str, float] | None = None,
+              fault_targets: set[tuple[str, str | None]] | None = None) -> dict[str, Any]:
+    """The run's summary (also written to RUN_DIR/summary.json); `fault_targets`: what the
+    run's faults act on (fault_targets(), for host_stalls)."""
     hung = hung or {}
     vote = voting(run_dir)
     events = [(t, f"{k} stopped") for k, t in killed.items()]
     events += [(t, f"{k} hung") for k, t in hung.items()]
     events += [(v["t_s"], f"{v['node']} voted out") for v in vote["voted_out"]]
     summary = flight_summary.summarise(run_dir, pilot, duration_s, wall_s, nodes=len(nodes),
-                                       plot=plot, events=sorted(events))
+                                       plot=plot, events=sorted(events),
+                                       fault_targets=fault_targets)
     summary["nodes"] = list(nodes)
     summary["killed"] = [{"node": k, "t_s": t} for k, t in sorted(killed.items())]
     summary["hung"] = [{"node": k, "t_s": t} for k, t in sorted(hung.items())]

@@ -34,22 +34,13 @@ _PILOT_MODE = MESSAGES["PILOT_MODE"]
 _PILOT_TARGETS = MESSAGES["PILOT_TARGETS"]
 _PILOT_STICK = MESSAGES["PILOT_STICK"]
 _ACT_STATUS = MESSAGES["ACT_STATUS"]
-_ACT_CMD = {MESSAGES[f"ACT_CMD_{c}"].frame_id: (i, MESSAGES[f"ACT_CMD_{c}"].decode)
-            for i, c in enumerate(CHANNELS)}
-_FCS_STATUS = {MESSAGES[f"FCS_STATUS_{c}"].frame_id: (i, MESSAGES[f"FCS_STATUS_{c}"].decode)
-               for i, c in enumerate(CHANNELS)}
-_NAV_POS = {MESSAGES[f"NAV_POS_{c}"].frame_id: (i, MESSAGES[f"NAV_POS_{c}"].decode)
-            for i, c in enumerate(CHANNELS)}
-_NAV_DATA = {MESSAGES[f"NAV_DATA_{c}"].frame_id: (i, MESSAGES[f"NAV_DATA_{c}"].decode)
-             for i, c in enumerate(CHANNELS)}
-_BRAKE_CMD = {MESSAGES[f"BRAKE_CMD_{c}"].frame_id: (i, MESSAGES[f"BRAKE_CMD_{c}"].decode)
-              for i, c in enumerate(CHANNELS)}
-# What the world does with a frame it receives, by identifier: (kind, channel, decode).
+# What the world does with a frame it receives, by identifier: (kind, channel, decode), for
+# each redundancy channel's message of each kind.
 _ACT, _BRAKE, _STATUS, _POS, _DATA = range(5)
-_HANDLED = {fid: (kind, *v) for kind, table in ((_ACT, _ACT_CMD), (_BRAKE, _BRAKE_CMD),
-                                                (_STATUS, _FCS_STATUS), (_POS, _NAV_POS),
-                                                (_DATA, _NAV_DATA))
-            for fid, v in table.items()}
+_HANDLED = {MESSAGES[f"{name}_{c}"].frame_id: (kind, i, MESSAGES[f"{name}_{c}"].decode)
+            for kind, name in ((_ACT, "ACT_CMD"), (_BRAKE, "BRAKE_CMD"), (_STATUS, "FCS_STATUS"),
+                               (_POS, "NAV_POS"), (_DATA, "NAV_DATA"))
+            for i, c in enumerate(CHANNELS)}
 NEAR_GROUND_FT = 15.0  # below this height (of the centre of gravity) the wheels are watched
 # The world leaves the quanta before its next task ungranted (World._delivered) only this far
 # from every limit a crash is judged by, and for SKIP_MAX_NS at most: no aircraft gets from

@@ -145,10 +145,6 @@ def _name(names: dict[int, str], v: Any) -> Any:
     return names.get(v, v) if isinstance(v, int) else v
 
 
-def hm_events(node_trace: Path) -> list[dict]:
-    return node_events(node_trace)[0]
-
-
 def node_events(node_trace: Path) -> tuple[list[dict], list[dict]]:
     """A node's health-monitor events, and the windows its partitions kept past their CPU
     budget (the SKE's `overrun` events of cause `cpu_budget`), in one reading of its trace."""

@@ -27,7 +27,6 @@ import re
 from pathlib import Path
 from typing import Any
 
-import jsonschema
 import yaml
 
 from faultinject import catalogue
@@ -194,6 +193,8 @@ def from_yaml_file(path: Path, first: int = 1) -> list[Fault]:
         raise FaultSpecError(f"{path}: cannot read: {exc}") from exc
     except yaml.YAMLError as exc:
         raise FaultSpecError(f"{path}: not valid YAML: {exc}") from exc
+    import jsonschema  # here: most launches have no faults file, and it takes 0.05 s
+
     e = first_schema_error(jsonschema.Draft202012Validator(_schema()), doc)
     if e is not None:
         raise FaultSpecError(f"{path}: {e}")
@@ -204,7 +205,9 @@ def first_schema_error(validator, doc) -> str | None:
     """The first error of a document, as `PATH: MESSAGE`; of an item that matches none of its
     alternatives (oneOf), the most relevant error of the alternatives, which names the bad
     value."""
-    found = [jsonschema.exceptions.best_match([e]) for e in validator.iter_errors(doc)]
+    from jsonschema.exceptions import best_match
+
+    found = [best_match([e]) for e in validator.iter_errors(doc)]
     if not found:
         return None
     e = sorted(found, key=lambda e: list(map(str, e.absolute_path)))[0]

@@ -3,12 +3,12 @@
 
 from __future__ import annotations
 
+import functools
+import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import jsonschema
-
-from ima import yamlfile
+from ima import schema_memo, yamlfile
 from ima.errors import ImaError
 
 MODES = ("DIRECT", "AUTOPILOT", "MISSION")
@@ -220,18 +220,33 @@ class PilotScript:
         return out
 
 
-def parse(doc, path: str = "<script>") -> PilotScript:
-    """Validate a parsed YAML document and build the script; PilotScriptError if it is bad."""
-    bad = yamlfile.first_not_finite(doc)
-    if bad is not None:
-        where, val = bad
-        raise PilotScriptError(f"{path}: {_path(where)}: {val} is not a finite number")
+@functools.cache
+def _schema_text() -> bytes:
+    return json.dumps(SCHEMA, sort_keys=True).encode()
+
+
+def _validate(doc, path: str) -> None:
+    """Against SCHEMA (a script found valid before is not validated again: ima.schema_memo)."""
+    if schema_memo.known_valid(_schema_text(), doc):
+        return
+    import jsonschema
+
     v = jsonschema.Draft202012Validator(SCHEMA)
     errors = sorted(v.iter_errors(doc), key=lambda e: (list(map(str, e.absolute_path)), e.message))
     if errors:
         lines = [f"{_path(e.absolute_path)}: {e.message}" for e in errors[:5]]
         more = f" (and {len(errors) - 5} more)" if len(errors) > 5 else ""
         raise PilotScriptError(f"{path}: bad pilot script: " + "; ".join(lines) + more)
+    schema_memo.remember_valid(_schema_text(), doc)
+
+
+def parse(doc, path: str = "<script>") -> PilotScript:
+    """Validate a parsed YAML document and build the script; PilotScriptError if it is bad."""
+    bad = yamlfile.first_not_finite(doc)
+    if bad is not None:
+        where, val = bad
+        raise PilotScriptError(f"{path}: {_path(where)}: {val} is not a finite number")
+    _validate(doc, path)
     events = [dict(e) for e in doc.get("events") or []]
     for i in range(1, len(events)):
         if events[i]["t"] < events[i - 1]["t"]:

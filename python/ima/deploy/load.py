@@ -10,11 +10,9 @@ import math
 import os
 from decimal import Decimal
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import jsonschema
-
-from ima import paths
+from ima import paths, schema_memo
 from ima.deploy.locate import path_text
 from ima.deploy.model import (
     ARGUMENT_FIELDS,
@@ -38,6 +36,9 @@ from ima.deploy.model import (
 )
 from ima.deploy.source import Source, read_source
 
+if TYPE_CHECKING:
+    import jsonschema
+
 MAX_ERRORS_SHOWN = 5
 QUEUE_BYTES_MAX = 64 * 1024 * 1024  # the SKE's limit on one queuing port
 MAX_DESTINATIONS = 16
@@ -53,12 +54,21 @@ def schema_path() -> Path:
 
 
 @functools.cache
-def _schema() -> dict:
+def _schema_text() -> bytes:
     path = schema_path()
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
+        return path.read_bytes()
+    except OSError as exc:
         raise SystemModelError(f"{path}: cannot read the system model schema: {exc}") from exc
+
+
+@functools.cache
+def _schema() -> dict:
+    try:
+        return json.loads(_schema_text())
+    except ValueError as exc:
+        raise SystemModelError(f"{schema_path()}: cannot read the system model schema: "
+                               f"{exc}") from exc
 
 
 def display_name(path: Path) -> str:
@@ -99,6 +109,12 @@ def load_system(path: Path | str) -> System:
 
 
 def _validate_schema(doc: Any, rep: _Reporter) -> None:
+    """The schema's errors, the first few of them named (a model found valid before is not
+    validated again: ima.schema_memo)."""
+    if schema_memo.known_valid(_schema_text(), doc):
+        return
+    import jsonschema
+
     validator = jsonschema.Draft202012Validator(_schema())
     # An error of an alternative ("not valid under any of the given schemas") is replaced by
     # the most relevant error of its alternatives, which names the value at fault.
@@ -107,6 +123,7 @@ def _validate_schema(doc: Any, rep: _Reporter) -> None:
                     key=lambda e: (rep.line(tuple(e.absolute_path)),
                                    list(map(str, e.absolute_path)), e.message))
     if not errors:
+        schema_memo.remember_valid(_schema_text(), doc)
         return
     first = errors[0]
     parts = tuple(first.absolute_path)

@@ -100,3 +100,19 @@ def test_a_window_kept_past_its_cpu_budget_without_a_fault_is_told_as_a_host_sta
     s = summary.summarise(tmp_path, _script(tmp_path, []), 1.0, fault_targets={("node1", "fdr")})
     assert (s["cpu_overrun_count"], len(s["cpu_overruns"])) == (61, 50)
     assert s["host_stall_count"] == 1 and s["host_stalls"][0]["partition"] == "io"
+
+
+@pytest.mark.parametrize("block", [1, 5, 64, 1 << 26])
+def test_read_jsonl_finds_the_lines_with_a_needle_across_blocks(tmp_path, monkeypatch, block):
+    """Lines found by searching the bytes, whatever the blocks the file is read in: in order,
+    each once even with several needles in it; cut, garbled and non-UTF-8 lines skipped."""
+    monkeypatch.setattr(summary, "READ_BLOCK", block)
+    p = tmp_path / "t.jsonl"
+    p.write_bytes(b'{"k":"hm","n":1}\n{"k":"x","n":2}\n\n{"k":"overrun hm","n":3}\r\n'
+                  b'{"k":"hm", garbled\n{"k":"hm","s":"\xff"}\n[1, "hm"]\n{"k":"x","n":4}\n'
+                  b'{"k":"hm","n":5}')  # the last line without its newline
+    assert [r["n"] for r in summary.read_jsonl(p, "hm")] == [1, 3, 5]
+    assert [r["n"] for r in summary.read_jsonl(p, ("overrun", "hm"))] == [1, 3, 5]
+    assert [r["n"] for r in summary.read_jsonl(p)] == [1, 2, 3, 4, 5]
+    assert list(summary.read_jsonl(p, "absent")) == []
+    assert list(summary.read_jsonl(tmp_path / "missing.jsonl")) == []

@@ -65,7 +65,7 @@ struct tm_conv {
 
 tm_conv_t *tm_new(int kind)
 {
-    if (kind != TM_CAN && kind != TM_SKE)
+    if (kind != TM_CAN && kind != TM_SKE && kind != TM_FDR)
         return NULL;
     tm_conv_t *c = calloc(1, sizeof *c);
     if (!c)
@@ -227,8 +227,8 @@ static tm_entries_t *entries_of(tm_conv_t *c, uint16_t cid)
 
 /* Starts a message record of `n` data bytes: its header and index entry; the data goes to the
  * returned place. */
-static uint8_t *message(tm_conv_t *c, uint16_t cid, uint64_t seq, uint64_t t, uint64_t base,
-                        size_t n)
+uint8_t *tm__message(tm_conv_t *c, uint16_t cid, uint64_t seq, uint64_t t, uint64_t base,
+                     size_t n)
 {
     tm_entries_t *e = entries_of(c, cid);
     if (!e || !reserve(c, MSG_HEAD + n))
@@ -362,7 +362,7 @@ static int can_line(tm_conv_t *c, const uint8_t *p, const uint8_t *end, uint64_t
         size_t num_n = tm__put_u64(num, seq);
         size_t line_n = (size_t)(end - p) - 1;
         size_t n = line_n + key->n + 7 + num_n + 1;
-        uint8_t *d = message(c, c->cid[TM_CAN_FRAMES], seq, t, base, n);
+        uint8_t *d = tm__message(c, c->cid[TM_CAN_FRAMES], seq, t, base, n);
         if (!d)
             return -1;
         memcpy(d, p, line_n);
@@ -376,7 +376,7 @@ static int can_line(tm_conv_t *c, const uint8_t *p, const uint8_t *end, uint64_t
         }
     }
     if (signals) {
-        uint8_t *d = message(c, m->sig_cid, seq, t, base, json_n);
+        uint8_t *d = tm__message(c, m->sig_cid, seq, t, base, json_n);
         if (!d)
             return -1;
         memcpy(d, json, json_n);
@@ -420,7 +420,7 @@ static int ske_line(tm_conv_t *c, const uint8_t *p, const uint8_t *end, uint64_t
                                                                     : TM_SKE_OTHER;
     if (!c->cid[which])
         return 1;
-    uint8_t *d = message(c, c->cid[which], seq, t, base, len);
+    uint8_t *d = tm__message(c, c->cid[which], seq, t, base, len);
     if (!d)
         return -1;
     memcpy(d, p, len);
@@ -429,14 +429,37 @@ static int ske_line(tm_conv_t *c, const uint8_t *p, const uint8_t *end, uint64_t
 
 /* ---- the lines -------------------------------------------------------------------------------- */
 
-int tm_convert(tm_conv_t *c, const uint8_t *text, size_t len, uint64_t seq, uint64_t base,
-               uint64_t room, uint32_t skip, tm_result_t *r)
+void tm__begin(tm_conv_t *c, tm_result_t *r)
 {
     c->out_len = 0;
     c->n_order = 0;
     for (size_t i = 0; i < c->n_chan; i++)
         c->chan[i].n = 0;
     *r = (tm_result_t){0};
+}
+
+void tm__end(const tm_conv_t *c, tm_result_t *r)
+{
+    r->out = c->out;
+    r->out_len = c->out_len;
+}
+
+uint16_t tm__channel(const tm_conv_t *c, int which)
+{
+    return c->cid[which];
+}
+
+size_t tm__out_len(const tm_conv_t *c)
+{
+    return c->out_len;
+}
+
+int tm_convert(tm_conv_t *c, const uint8_t *text, size_t len, uint64_t seq, uint64_t base,
+               uint64_t room, uint32_t skip, tm_result_t *r)
+{
+    if (c->kind == TM_FDR)
+        return TM_NOMEM; /* tm_fdr's */
+    tm__begin(c, r);
     int rc = TM_DONE;
     size_t pos = 0;
     while (pos < len) {
@@ -472,8 +495,7 @@ int tm_convert(tm_conv_t *c, const uint8_t *text, size_t len, uint64_t seq, uint
         }
     }
     r->consumed = pos;
-    r->out = c->out;
-    r->out_len = c->out_len;
+    tm__end(c, r);
     return rc;
 }
 

@@ -44,6 +44,20 @@ int tm__hex_digit(uint8_t h);
 size_t tm__put_u64(char *p, uint64_t v);
 size_t tm__put_i64(char *p, int64_t v);
 
+/* The converter's output (trace_mcap.c), for the converters in files of their own
+ * (trace_mcap_fdr.c): a call starts with tm__begin, adds messages (tm__message: the header and
+ * index entry of a message of n data bytes, the data to go at the place returned; NULL when
+ * out of memory) and ends with tm__end. */
+#ifndef __cplusplus
+#include "trace_mcap/trace_mcap.h"
+void tm__begin(tm_conv_t *c, tm_result_t *r);
+void tm__end(const tm_conv_t *c, tm_result_t *r);
+uint8_t *tm__message(tm_conv_t *c, uint16_t cid, uint64_t seq, uint64_t t, uint64_t base,
+                     size_t n);
+uint16_t tm__channel(const tm_conv_t *c, int which);
+size_t tm__out_len(const tm_conv_t *c);
+#endif
+
 /* x > 0 and finite: x = 0.DIGITS * 10^point; returns the number of digits (1 to 17). */
 size_t tm__shortest(double x, char *digits, int *point);
 

@@ -10,6 +10,7 @@ import json
 import math
 import random
 import struct
+import zlib
 from pathlib import Path
 
 import orjson
@@ -173,3 +174,71 @@ def test_more_messages_than_the_c_holds_are_recorded_all_the_same(tmp_path, monk
     (run / "can.jsonl").write_text("\n".join(lines) + "\n")
     assert _record(run, tmp_path / "c.mcap", True, monkeypatch) == \
         _record(run, tmp_path / "py.mcap", False, monkeypatch)
+
+
+def _fdr_record(kind: int, seq: int, t_ns: int, body: bytes, body_len: int | None = None,
+                bad_crc: bool = False) -> bytes:
+    from ima.fdr import records
+    head = records.HEADER.pack(records.MAGIC, records.VERSION, kind, seq,
+                               len(body) if body_len is None else body_len, t_ns)
+    rec = (head + body).ljust(records.RECORD_SIZE - 4, b"\0")
+    crc = zlib.crc32(rec) ^ (1 if bad_crc else 0)
+    return rec + struct.pack("<I", crc)
+
+
+def _fdr_file(rng: random.Random) -> bytes:
+    from ima.fdr import records
+    specials = [math.nan, math.inf, -math.inf, -0.0, 0.0, 1e-7, 1e16, 123456789.125, -5e-324,
+                1.7976931348623157e308]
+
+    def d() -> float:
+        return rng.choice(specials) if rng.random() < 0.1 else rng.uniform(-1e4, 1e4)
+
+    def u() -> int:
+        return rng.choice([0, 1, 7, 2**32 - 1, rng.randrange(2**32)])
+
+    def frame(k: int) -> bytes:
+        nav = records.NAV.pack(rng.randrange(-2**63, 2**63), u(), u(), *[d() for _ in range(12)])
+        st = records.STATUS.pack(rng.randrange(2**40), *[u() for _ in range(8)],
+                                 *[d() for _ in range(4)])
+        mis = records.MISSION.pack(-rng.randrange(2**40), *[u() for _ in range(4)],
+                                   *[d() for _ in range(4)])
+        return records.FRAME_HEAD.pack(k, rng.randrange(8)) + nav + st + mis
+
+    start = records.START.pack(1, 2, records.RECORD_SIZE, 0, b"node1")
+    hm = records.HM.pack(5, b"io", b"rx\xff\xfe", 1, 1, 2, 3, 4, -5, 6, b"overrun \xc3", 0)
+    out = [_fdr_record(1, 0, 0, start)]
+    for k in range(1, 1500):
+        t = rng.choice([k * 50_000_000, 0, -7]) if rng.random() < 0.05 else k * 50_000_000
+        out.append(_fdr_record(2, k, t, frame(k)))
+    for k, rec in enumerate([_fdr_record(3, 9, 10, hm), _fdr_record(2, 9, 10, frame(9), 100),
+                             _fdr_record(2, 9, 10, frame(9), bad_crc=True),
+                             b"\0" * records.RECORD_SIZE, _fdr_record(1, 9, 10, start)]):
+        out.insert(50 + 137 * k, rec)
+    return b"".join(out) + b"FDR1 cut"
+
+
+def test_the_c_writes_a_flight_data_recording_as_the_python_does(tmp_path, monkeypatch):
+    """Frame records by the C, the start and HM records handed back, torn ones (a bad CRC, a
+    frame's body too short, zeros) and a cut tail skipped: the same file, whatever the chunk
+    size."""
+    run = tmp_path / "run"
+    _traces(run, random.Random(5))
+    (run / "node1.fdr").write_bytes(_fdr_file(random.Random(3)))
+    for chunk_bytes in (1 << 20, 5000, 900):
+        monkeypatch.setattr(write, "CHUNK_BYTES", chunk_bytes)
+        c_file = _record(run, tmp_path / f"c{chunk_bytes}.mcap", True, monkeypatch)
+        py_file = _record(run, tmp_path / f"py{chunk_bytes}.mcap", False, monkeypatch)
+        assert c_file == py_file, f"chunks of {chunk_bytes} bytes"
+    calls = []
+    real_fdr = fast.fdr
+
+    def spy(out, topic, data, python):
+        def counted(k, seq):
+            calls.append(k)
+            return python(k, seq)
+        return real_fdr(out, topic, data, counted)
+
+    monkeypatch.setattr(fast, "fdr", spy)
+    _record(run, tmp_path / "spy.mcap", True, monkeypatch)
+    assert len(calls) == 3, calls  # the two start records and the HM record: the rest is the C's

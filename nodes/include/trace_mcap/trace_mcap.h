@@ -16,9 +16,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
-enum { TM_CAN = 1, TM_SKE = 2 };                            /* which trace a converter reads */
+enum { TM_CAN = 1, TM_SKE = 2, TM_FDR = 3 };               /* which trace a converter reads */
 enum { TM_DONE = 0, TM_PYTHON = 1, TM_FULL = 2, TM_NOMEM = -1 }; /* tm_convert's answers */
-enum { TM_CAN_FRAMES = 0, TM_SKE_SCHEDULE = 0, TM_SKE_HM = 1, TM_SKE_OTHER = 2 };
+enum { TM_CAN_FRAMES = 0, TM_SKE_SCHEDULE = 0, TM_SKE_HM = 1, TM_SKE_OTHER = 2,
+       TM_FDR_RECORDS = 0 };
 
 typedef struct tm_conv tm_conv_t;
 
@@ -65,6 +66,18 @@ size_t tm_entries(const tm_conv_t *c, uint16_t cid, const uint64_t **pairs);
 
 /* A finite double as orjson writes it (shortest round trip: 12.34, 1e-7, 1e+16); its length
  * (at most 32 bytes, no terminating NUL), 0 for a NaN or an infinity. */
+/* A flight data recorder file's records (TM_FDR converter; partitions/fdr/fdr.h: fixed
+ * 320-byte records, each a header, a body and a CRC-32): of the file's `n` whole records at
+ * `data`, those from record `from` on, the first good one numbered `seq`, as messages of the
+ * node's fdr topic (TM_FDR_RECORDS), each what the recorder's Python writes
+ * (python/ima/recording/write.py: the JSON of ima.fdr.records' decoding, with its "kind"). A
+ * torn frame record (bad magic, version, length or CRC) or one of no kind is skipped.
+ * `r->consumed` is the record reached, `r->lines` the good records out. It hands back
+ * (TM_PYTHON) the record at `consumed` if it is a start or a health-monitor record (the Python
+ * judges whether it is torn) or while it has no channel; TM_FULL once `room` bytes are out. */
+int tm_fdr(tm_conv_t *c, const uint8_t *data, size_t n, size_t from, uint64_t seq,
+           uint64_t base, uint64_t room, tm_result_t *r);
+
 size_t tm_format_double(double x, char *buf);
 
 #endif

@@ -43,6 +43,8 @@ MODES = ("INIT", "DIRECT", "AUTOPILOT", "MISSION", "CONTINGENCY")
 FALLBACKS = ("NONE", "C2_LOST", "MISSION_STALE", "NAV_INVALID", "NO_TARGETS", "SENSOR_LOST")
 
 assert NAV.size == 112 and STATUS.size == 72 and MISSION.size == 56 and HM.size == 232
+BODY_MIN = {1: START.size, 2: FRAME_HEAD.size + NAV.size + STATUS.size + MISSION.size,
+            3: HM.size}
 
 
 def _text(raw: bytes) -> str:
@@ -81,37 +83,37 @@ class Recording:
         }
 
 
-def _decode(rec: bytes, off: int, out: Recording) -> bool:
+def decode(rec: bytes, off: int) -> tuple[str, dict] | None:
+    """One record (RECORD_SIZE bytes, at file offset `off`): its kind ("start", "frame",
+    "hm") and fields; None if it is torn (a body too short for its kind counts as torn)."""
     magic, version, kind, seq, body_len, t_ns = HEADER.unpack_from(rec)
     crc = struct.unpack_from("<I", rec, RECORD_SIZE - 4)[0]
     if magic != MAGIC or version != VERSION or kind not in KINDS or body_len > BODY_MAX or \
-            zlib.crc32(rec[:RECORD_SIZE - 4]) != crc:
-        return False
+            body_len < BODY_MIN[kind] or zlib.crc32(rec[:RECORD_SIZE - 4]) != crc:
+        return None
     body = rec[HEADER.size:HEADER.size + body_len]
     base = {"seq": seq, "t_ns": t_ns, "offset": off}
     if kind == 1:
         cond, mode, size, _, node = START.unpack_from(body)
-        out.starts.append(base | {"start_condition": cond, "operating_mode": mode,
-                                  "node": _text(node), "record_size": size})
-    elif kind == 2:
+        return "start", base | {"start_condition": cond, "operating_mode": mode,
+                                "node": _text(node), "record_size": size}
+    if kind == 2:
         frame, valid = FRAME_HEAD.unpack_from(body)
         o = FRAME_HEAD.size
         nav = _named(NAV_FIELDS, NAV.unpack_from(body, o))
         st = _named(STATUS_FIELDS, STATUS.unpack_from(body, o + NAV.size))
         mis = _named(MISSION_FIELDS, MISSION.unpack_from(body, o + NAV.size + STATUS.size))
-        out.frames.append(base | {"frame": frame,
-                                  "nav": nav if valid & HAVE_NAV else None,
-                                  "status": st if valid & HAVE_STATUS else None,
-                                  "mission": mis if valid & HAVE_MISSION else None})
-    else:
-        (t, part, proc, err, level, action, state, pid, code, n, msg, _) = HM.unpack_from(body)
-        out.hm.append(base | {"hm_t_ns": t, "partition": _text(part), "process": _text(proc),
-                              "error": HM_ERRORS.get(err, str(err)),
-                              "level": HM_LEVELS.get(level, str(level)),
-                              "action": HM_ACTIONS.get(action, str(action)), "state": state,
-                              "process_id": pid,
-                              "error_code": code, "message": _text(msg[:min(n, 128)])})
-    return True
+        return "frame", base | {"frame": frame,
+                                "nav": nav if valid & HAVE_NAV else None,
+                                "status": st if valid & HAVE_STATUS else None,
+                                "mission": mis if valid & HAVE_MISSION else None}
+    (t, part, proc, err, level, action, state, pid, code, n, msg, _) = HM.unpack_from(body)
+    return "hm", base | {"hm_t_ns": t, "partition": _text(part), "process": _text(proc),
+                         "error": HM_ERRORS.get(err, str(err)),
+                         "level": HM_LEVELS.get(level, str(level)),
+                         "action": HM_ACTIONS.get(action, str(action)), "state": state,
+                         "process_id": pid,
+                         "error_code": code, "message": _text(msg[:min(n, 128)])}
 
 
 def read(path: Path) -> Recording:
@@ -120,9 +122,13 @@ def read(path: Path) -> Recording:
     out = Recording(Path(path))
     whole = len(data) - len(data) % RECORD_SIZE
     out.tail_bytes = len(data) - whole
+    lists = {"start": out.starts, "frame": out.frames, "hm": out.hm}
     for off in range(0, whole, RECORD_SIZE):
-        if not _decode(data[off:off + RECORD_SIZE], off, out):
+        got = decode(data[off:off + RECORD_SIZE], off)
+        if got is None:
             out.torn.append(off)
+        else:
+            lists[got[0]].append(got[1])
     last = None
     for f in out.frames:
         if last is not None and f["frame"] > last + 1:

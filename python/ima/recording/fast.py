@@ -26,9 +26,10 @@ import orjson
 
 from ima.recording.topics import Topics
 
-TM_CAN, TM_SKE = 1, 2
+TM_CAN, TM_SKE, TM_FDR = 1, 2, 3
 TM_DONE, TM_PYTHON, TM_FULL = 0, 1, 2
-TM_CAN_FRAMES, TM_SKE_SCHEDULE, TM_SKE_HM, TM_SKE_OTHER = 0, 0, 1, 2
+TM_CAN_FRAMES, TM_SKE_SCHEDULE, TM_SKE_HM, TM_SKE_OTHER, TM_FDR_RECORDS = 0, 0, 1, 2, 0
+FDR_RECORD = 320  # partitions/fdr/fdr.h (ima.fdr.records.RECORD_SIZE)
 BATCH_LINES = 50_000  # a whole trace is converted this many lines at a time
 
 Lines = Iterable[tuple[int, bytes]]
@@ -81,6 +82,8 @@ def _declare(lib: ctypes.CDLL) -> None:
             ("tm_channels", c.c_size_t, [c.c_void_p, c.POINTER(c.POINTER(c.c_uint16))]),
             ("tm_entries", c.c_size_t, [c.c_void_p, c.c_uint16,
                                         c.POINTER(c.POINTER(c.c_uint64))]),
+            ("tm_fdr", c.c_int, [c.c_void_p, c.c_void_p, c.c_size_t, c.c_size_t, c.c_uint64,
+                                 c.c_uint64, c.c_uint64, c.POINTER(_Result)]),
             ("tm_format_double", c.c_size_t, [c.c_double, c.c_char_p])):
         f = getattr(lib, name)
         f.restype, f.argtypes = res, args
@@ -225,6 +228,40 @@ class SkeConverter(_Converter):
             if cid:
                 self.lib.tm_set_channel(self.conv, which, cid)
                 del self.topics[which]
+
+
+def fdr(out, topic: str, data: bytes, python: Callable[[int, int], bool]) -> bool:
+    """A flight data recorder file's records as messages of `topic` (write.py's _fdr): the
+    frame records by the C, each record it hands back by `python(k, seq)` (record k, numbered
+    seq among the good ones; it puts the message, or says the record is torn). False if the
+    library is not built (nothing done)."""
+    lib = library()
+    if lib is None:
+        return False
+    conv = _Converter(lib, TM_FDR, out, None)
+    try:
+        n = len(data) // FDR_RECORD
+        addr = ctypes.cast(ctypes.c_char_p(data), ctypes.c_void_p)  # read only, no copy
+        res, w = conv._res, out.w
+        k = seq = 0
+        while k < n:
+            cid = out.channels.get(topic)
+            if cid:
+                lib.tm_set_channel(conv.conv, TM_FDR_RECORDS, cid)
+            used = w.chunk_used()
+            rc = lib.tm_fdr(conv.conv, addr, n, k, seq, used, max(0, w.chunk_bytes - used),
+                            ctypes.byref(res))
+            if rc < 0:
+                raise MemoryError("trace_mcap: out of memory")
+            if res.out_len:
+                w.add_records(ctypes.string_at(res.out, res.out_len), conv._entries())
+            k, seq = res.consumed, seq + res.lines
+            if rc == TM_PYTHON:
+                seq += python(k, seq)
+                k += 1
+    finally:
+        conv.close()
+    return True
 
 
 class FastTopics(Topics):

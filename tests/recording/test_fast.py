@@ -18,6 +18,7 @@ import pytest
 
 from ima.canbus import codec
 from ima.recording import fast, write
+from ima.recording.follow import Follow
 from ima.recording.topics import Topics
 
 
@@ -153,8 +154,12 @@ def test_a_trace_is_read_a_block_at_a_time_line_by_line(tmp_path):
         with open(path, "rb") as f:
             expected = [(i, line.rstrip(b"\n")) for i, line in enumerate(f)]
         for block in (1, 7, 64, 1 << 22):
-            assert list(write._numbered(path, block)) == expected, (block, len(text))
-    assert list(write._numbered(tmp_path / "missing.jsonl")) == []
+            f = Follow(path)
+            got = [line for b in f.raw_blocks(block) for line in b.lines()]
+            f.close()
+            assert got == expected, (block, len(text))
+            assert [line for ls in Follow(path).blocks(block) for line in ls] == expected
+    assert list(Follow(tmp_path / "missing.jsonl").raw_blocks(5)) == []
 
 
 def test_more_messages_than_the_c_holds_are_recorded_all_the_same(tmp_path, monkeypatch):

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import orjson
 
+from ima.recording.follow import Block
 from ima.recording.topics import Topics
 
 TM_CAN, TM_SKE, TM_FDR = 1, 2, 3
@@ -112,6 +113,31 @@ class _Converter:
         it = iter(lines)
         while batch := list(itertools.islice(it, BATCH_LINES)):
             self._batch(batch)
+
+    def block(self, block: Block) -> None:
+        """A block of the trace's lines as read (recording/follow.py), handed to the C as it
+        is: only the lines the C hands back are split out."""
+        data = block.data
+        addr = ctypes.cast(ctypes.c_char_p(data), ctypes.c_void_p).value  # read only, no copy
+        lib, conv, res, w = self.lib, self.conv, self._res, self.out.w
+        pos, num, skip = 0, block.first, 0
+        while pos < len(data):
+            used = w.chunk_used()
+            rc = lib.tm_convert(conv, addr + pos, len(data) - pos, num, used,
+                                max(0, w.chunk_bytes - used), skip, ctypes.byref(res))
+            if rc < 0:
+                raise MemoryError("trace_mcap: out of memory")
+            if res.out_len:
+                w.add_records(ctypes.string_at(res.out, res.out_len), self._entries())
+            pos += res.consumed
+            num += res.lines
+            skip = res.part if rc == TM_FULL else 0
+            if rc == TM_PYTHON and pos < len(data):  # a line the C leaves to the Python
+                end = data.find(b"\n", pos)
+                end = len(data) if end < 0 else end  # a cut last line
+                self.python([(num, data[pos:end])])
+                self.learn()
+                pos, num = end + 1, num + 1
 
     def _batch(self, lines: list[tuple[int, bytes]]) -> None:
         if lines[-1][0] - lines[0][0] != len(lines) - 1:  # not numbered in a row: never so
@@ -274,16 +300,35 @@ class FastTopics(Topics):
         self._can: CanConverter | None = None
         self._ske: dict[str, SkeConverter] = {}
 
-    def can(self, lines: Lines) -> None:
+    def traces(self, run_dir, nodes):
+        """Topics.traces(), the bus's and the SKEs' blocks handed to the C as they are."""
+        out = super().traces(run_dir, nodes)
+        fast = {f"{node}.jsonl": partial(self._ske_block, node) for node in nodes}
+        fast["can.jsonl"] = self._can_block
+        return [(path, fast.get(path.name, feed)) for path, feed in out]
+
+    def _can_converter(self) -> CanConverter:
         if self._can is None:
             self._can = CanConverter(self._lib, self.out, self)
-        self._can(lines)
+        return self._can
 
-    def ske(self, node: str, lines: Lines) -> None:
+    def _ske_converter(self, node: str) -> SkeConverter:
         conv = self._ske.get(node)
         if conv is None:
             conv = self._ske[node] = SkeConverter(self._lib, self.out, self, node)
-        conv(lines)
+        return conv
+
+    def can(self, lines: Lines) -> None:
+        self._can_converter()(lines)
+
+    def ske(self, node: str, lines: Lines) -> None:
+        self._ske_converter(node)(lines)
+
+    def _can_block(self, block: Block) -> None:
+        self._can_converter().block(block)
+
+    def _ske_block(self, node: str, block: Block) -> None:
+        self._ske_converter(node).block(block)
 
     def close(self) -> None:
         for conv in [self._can, *self._ske.values()]:

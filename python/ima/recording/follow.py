@@ -1,13 +1,30 @@
 # SPDX-License-Identifier: Apache-2.0
 """The complete lines a growing trace file has gained since the last look, numbered from 0 as
 the recording numbers them. A line still being written stays for the next look. (The
-recorder and the live server follow a run's traces with it.)"""
+recorder and the live server follow a run's traces with it.)
+
+They come as blocks: the bytes of whole lines, each ended by its newline, with the number of
+the first (a cut last line, once the file is complete, without its newline). The recording's
+C takes a block as it is (recording/fast.py); the others read its lines."""
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterable
 from pathlib import Path
+from typing import NamedTuple
+
+
+class Block(NamedTuple):
+    first: int  # the number of the first line
+    data: bytes
+
+    def lines(self) -> list[tuple[int, bytes]]:
+        """(number, line without its newline) of each line."""
+        parts = self.data.split(b"\n")
+        if parts[-1] == b"":
+            parts.pop()  # after the last newline
+        return list(enumerate(parts, self.first))
 
 
 class Follow:
@@ -20,14 +37,27 @@ class Follow:
     def new_lines(self) -> list[tuple[int, bytes]]:
         """(number, line without its newline) of every line completed since the last call;
         nothing while the file does not exist."""
-        return self._split(self._read(-1))
+        block = self._block(self._read(-1))
+        return block.lines() if block else []
+
+    def new_block(self) -> Block | None:
+        """The lines completed since the last call (None: none)."""
+        return self._block(self._read(-1))
 
     def blocks(self, size: int):
         """Every line of a complete file, `size` bytes read at a time (a cut last line too):
         lists of (number, line)."""
+        for block in self.raw_blocks(size):
+            yield block.lines()
+
+    def raw_blocks(self, size: int):
+        """Every line of a complete file, `size` bytes read at a time (a cut last line too):
+        Blocks."""
         while data := self._read(size):
-            yield self._split(data)
-        yield self.rest()
+            block = self._block(data)
+            if block:
+                yield block
+        yield from self.rest_blocks()
 
     def _read(self, size: int) -> bytes:
         if self._f is None:
@@ -37,24 +67,31 @@ class Follow:
                 return b""
         return self._f.read(size)
 
-    def _split(self, data: bytes) -> list[tuple[int, bytes]]:
+    def _block(self, data: bytes) -> Block | None:
         if not data:
-            return []
-        parts = (self._tail + data).split(b"\n")
-        self._tail = parts.pop()
-        first = self._next
-        self._next += len(parts)
-        return list(enumerate(parts, first))
+            return None
+        data = self._tail + data
+        end = data.rfind(b"\n") + 1
+        self._tail = data[end:]
+        if not end:
+            return None
+        block = Block(self._next, data[:end])
+        self._next += block.data.count(b"\n")
+        return block
 
     def rest(self) -> list[tuple[int, bytes]]:
         """The last line if its writer never ended it (a cut line: the reader skips and counts
         it), once the file is complete; read first what new_lines() has not."""
-        lines = self.new_lines()
+        return [line for block in self.rest_blocks() for line in block.lines()]
+
+    def rest_blocks(self) -> list[Block]:
+        """rest(), as blocks."""
+        blocks = [b for b in (self.new_block(),) if b]
         if self._tail:
-            lines.append((self._next, self._tail))
+            blocks.append(Block(self._next, self._tail))
             self._next += 1
             self._tail = b""
-        return lines
+        return blocks
 
     def close(self) -> None:
         if self._f is not None:
@@ -62,7 +99,7 @@ class Follow:
             self._f = None
 
 
-def feed_until(traces: Iterable[tuple[Path, Callable]], ended: Callable[[], bool],
+def feed_until(traces: Iterable[tuple[Path, Callable[[Block], None]]], ended: Callable[[], bool],
                poll_s: float) -> None:
     """Follows each (trace, feed) and hands feed its new lines every poll_s until ended() is
     true (the writers have stopped), then what is left, a cut last line included."""
@@ -70,14 +107,24 @@ def feed_until(traces: Iterable[tuple[Path, Callable]], ended: Callable[[], bool
     try:
         while not ended():
             for f, feed in follows:
-                lines = f.new_lines()
-                if lines:
-                    feed(lines)
+                block = f.new_block()
+                if block:
+                    feed(block)
             time.sleep(poll_s)
         for f, feed in follows:
-            lines = f.rest()
-            if lines:
-                feed(lines)
+            for block in f.rest_blocks():
+                feed(block)
     finally:
         for f, _ in follows:
+            f.close()
+
+
+def feed_all(traces: Iterable[tuple[Path, Callable[[Block], None]]], size: int) -> None:
+    """Hands each complete trace's lines to its feed, `size` bytes read at a time."""
+    for path, feed in traces:
+        f = Follow(path)
+        try:
+            for block in f.raw_blocks(size):
+                feed(block)
+        finally:
             f.close()

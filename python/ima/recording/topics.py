@@ -19,12 +19,17 @@ from pathlib import Path
 import orjson
 
 from ima.recording import schemas
+from ima.recording.follow import Block
 
 _FT = 0.3048
 _T_PREFIX = b'{"t_ns":'
 _SKE_TOPICS = {b"window_start": "schedule", b"window_end": "schedule", b"hm": "hm"}
 
 Lines = Iterable[tuple[int, bytes]]  # (number, line without its newline)
+
+
+def _by_lines(feed: Callable[[Lines], None]) -> Callable[[Block], None]:
+    return lambda block: feed(block.lines())
 
 
 def _arinc825(can_id: int) -> dict:
@@ -49,16 +54,17 @@ class Topics:
         self._extra_of: dict[tuple, bytes] = {}  # a frame's added fields, by id and kind
         self._sig: dict[str, tuple] = {}  # a message's topic, schema name, schema, signals
 
-    def traces(self, run_dir: Path, nodes: list[str]) -> list[tuple[Path, Callable[[Lines], None]]]:
-        """Every line-based trace of a run with its feeder, in the recording's order."""
+    def traces(self, run_dir: Path, nodes: list[str]) -> list[tuple[Path, Callable[[Block], None]]]:
+        """Every line-based trace of a run with what takes its blocks of lines
+        (recording/follow.py), in the recording's order."""
         run_dir = Path(run_dir)
-        out: list[tuple[Path, Callable[[Lines], None]]] = [(run_dir / "can.jsonl", self.can)]
+        out = [(run_dir / "can.jsonl", self.can)]
         for k, node in enumerate(nodes, start=1):
             out.append((run_dir / f"{node}.jsonl", partial(self.ske, node)))
             out.append((run_dir / f"dds{k}.jsonl", partial(self.dds, node, f"dds{k}.jsonl")))
         out.append((run_dir / "world.jsonl", self.world))
         out.append((run_dir / "truth.jsonl", self.truth))
-        return out
+        return [(path, _by_lines(feed)) for path, feed in out]
 
     def _signals(self, msg) -> tuple[str, str, bytes, tuple[str, ...]]:
         """The topic, schema name, schema and signal names of a DBC message's signals."""

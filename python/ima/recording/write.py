@@ -20,12 +20,13 @@ import orjson
 
 from ima.errors import ImaError
 from ima.recording import fast, schemas
-from ima.recording.follow import Follow, feed_until
+from ima.recording.follow import feed_all, feed_until
 
 NAME = "run.mcap"
 CHUNK_BYTES = 1 << 20
 ZSTD_LEVEL = 1  # the traces' JSON: as small as level 3 here, and faster
 POLL_S = 0.05  # how often a followed run's traces are read
+READ_BLOCK = 1 << 22  # a complete trace is read this many bytes at a time
 
 
 class _Out:
@@ -57,17 +58,6 @@ class _Out:
             seq: int) -> None:
         ch = self.channels.get(topic) or self.channel(topic, schema_name, schema)
         self.w.message(ch, seq, t_ns if t_ns > 0 else 0, data)
-
-
-def _numbered(path: Path, block: int = 1 << 22):
-    """(number, line without its newline) of a trace, read a block at a time; nothing if it
-    cannot be read."""
-    f = Follow(path)
-    try:
-        for lines in f.blocks(block):
-            yield from lines
-    finally:
-        f.close()
 
 
 def _fdr(out: _Out, run_dir: Path, node: str) -> None:
@@ -157,12 +147,7 @@ def record(run_dir: Path, output: Path | None = None, before_verdicts=None,
                 nodes = list(nodes or launch.get("nodes") or sorted(
                     p.stem for p in run_dir.glob("node*.jsonl") if p.stem[4:].isdigit()))
                 if follow is None:
-                    topics.can(_numbered(run_dir / "can.jsonl"))
-                    for k, node in enumerate(nodes, start=1):
-                        topics.ske(node, _numbered(run_dir / f"{node}.jsonl"))
-                        topics.dds(node, f"dds{k}.jsonl", _numbered(run_dir / f"dds{k}.jsonl"))
-                    topics.world(_numbered(run_dir / "world.jsonl"))
-                    topics.truth(_numbered(run_dir / "truth.jsonl"))
+                    feed_all(topics.traces(run_dir, nodes), READ_BLOCK)
                 for node in nodes:
                     _fdr(out, run_dir, node)
                 if before_verdicts is not None:

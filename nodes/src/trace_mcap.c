@@ -444,6 +444,11 @@ void tm__end(const tm_conv_t *c, tm_result_t *r)
     r->out_len = c->out_len;
 }
 
+int tm__kind(const tm_conv_t *c)
+{
+    return c->kind;
+}
+
 uint16_t tm__channel(const tm_conv_t *c, int which)
 {
     return c->cid[which];
@@ -457,9 +462,9 @@ size_t tm__out_len(const tm_conv_t *c)
 int tm_convert(tm_conv_t *c, const uint8_t *text, size_t len, uint64_t seq, uint64_t base,
                uint64_t room, uint32_t skip, tm_result_t *r)
 {
-    if (c->kind == TM_FDR)
-        return TM_NOMEM; /* tm_fdr's */
     tm__begin(c, r);
+    if (c->kind == TM_FDR)
+        return TM_NOMEM; /* tm_fdr's: nothing done */
     int rc = TM_DONE;
     size_t pos = 0;
     while (pos < len) {

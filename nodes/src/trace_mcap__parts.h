@@ -54,6 +54,7 @@ void tm__begin(tm_conv_t *c, tm_result_t *r);
 void tm__end(const tm_conv_t *c, tm_result_t *r);
 uint8_t *tm__message(tm_conv_t *c, uint16_t cid, uint64_t seq, uint64_t t, uint64_t base,
                      size_t n);
+int tm__kind(const tm_conv_t *c);
 uint16_t tm__channel(const tm_conv_t *c, int which);
 size_t tm__out_len(const tm_conv_t *c);
 #endif

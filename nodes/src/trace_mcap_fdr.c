@@ -178,6 +178,8 @@ int tm_fdr(tm_conv_t *c, const uint8_t *data, size_t n, size_t from, uint64_t se
            uint64_t base, uint64_t room, tm_result_t *r)
 {
     tm__begin(c, r);
+    if (tm__kind(c) != TM_FDR)
+        return TM_NOMEM; /* not an FDR converter: nothing done */
     uint16_t cid = tm__channel(c, TM_FDR_RECORDS);
     int rc = TM_DONE;
     char json[JSON_MAX];
@@ -191,10 +193,6 @@ int tm_fdr(tm_conv_t *c, const uint8_t *data, size_t n, size_t from, uint64_t se
             rc = TM_PYTHON;
             break;
         }
-        if (tm__out_len(c) >= room) {
-            rc = TM_FULL;
-            break;
-        }
         size_t len = frame_json(rec, (uint64_t)k * FDR_RECORD, json);
         int64_t t = (int64_t)u64(rec + 16);
         uint8_t *d = tm__message(c, cid, seq + r->lines, t > 0 ? (uint64_t)t : 0, base, len);
@@ -204,6 +202,11 @@ int tm_fdr(tm_conv_t *c, const uint8_t *data, size_t n, size_t from, uint64_t se
         }
         memcpy(d, json, len);
         r->lines++;
+        if (tm__out_len(c) >= room) { /* the chunk is full after this record, as message() has it */
+            k++;
+            rc = k < n ? TM_FULL : TM_DONE;
+            break;
+        }
     }
     r->consumed = k;
     tm__end(c, r);

@@ -258,7 +258,14 @@ static void test_fdr_records(void)
     const uint64_t *pairs;
     CHECK(tm_entries(c, 6, &pairs) == 2 && pairs[0] == 100 && pairs[1] == 50);
     CHECK(tm_fdr(c, file, 4, 4, 12, 0, 1 << 20, &r) == TM_DONE && r.consumed == 4);
-    CHECK(tm_fdr(c, file, 1, 0, 0, 0, 0, &r) == TM_FULL && r.consumed == 0); /* no room */
+    /* no room: one record all the same (the caller's chunk is then full), then TM_FULL */
+    CHECK(tm_fdr(c, file, 4, 0, 0, 0, 0, &r) == TM_FULL && r.consumed == 1 && r.lines == 1);
+    CHECK(tm_fdr(c, file, 1, 0, 0, 0, 0, &r) == TM_DONE && r.consumed == 1 && r.lines == 1);
+    tm_conv_t *ske = tm_new(TM_SKE); /* another kind of converter: nothing done */
+    CHECK(tm_fdr(ske, file, 4, 0, 0, 0, 1 << 20, &r) == TM_NOMEM && r.lines == 0);
+    CHECK(tm_convert(c, (const uint8_t *)"x\n", 2, 0, 0, 1 << 20, 0, &r) == TM_NOMEM);
+    CHECK(r.lines == 0 && r.out_len == 0);
+    tm_free(ske);
 
     /* frame records of random content with a good CRC, each in a buffer of its own size: every
      * one converted, nothing read out of bounds (ASan) */

@@ -115,4 +115,5 @@ def test_read_jsonl_finds_the_lines_with_a_needle_across_blocks(tmp_path, monkey
     assert [r["n"] for r in summary.read_jsonl(p, ("overrun", "hm"))] == [1, 3, 5]
     assert [r["n"] for r in summary.read_jsonl(p)] == [1, 2, 3, 4, 5]
     assert list(summary.read_jsonl(p, "absent")) == []
+    assert [r["n"] for r in summary.read_jsonl(p, ("", "absent"))] == [1, 2, 3, 4, 5]
     assert list(summary.read_jsonl(tmp_path / "missing.jsonl")) == []

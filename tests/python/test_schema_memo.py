@@ -5,6 +5,7 @@ document's and the schema's content."""
 from __future__ import annotations
 
 import shutil
+from pathlib import Path
 
 import jsonschema
 import pytest
@@ -66,10 +67,25 @@ def test_a_system_model_changed_after_it_was_found_valid_is_validated_again(buil
         load.load_system(model)
 
 
-def test_without_a_writable_build_tree_documents_are_validated(tmp_path, monkeypatch):
+def test_without_a_usable_build_tree_documents_are_validated(tmp_path, monkeypatch):
     blocked = tmp_path / "file"
     blocked.write_text("")
     monkeypatch.setenv("IMA_BUILD_DIR", str(blocked))  # validated/ cannot be made in a file
     script = pilot.load(paths.repo_root() / "sim" / "pilots" / "default.yaml")
     assert script.start["altitude_ft"] > 0
-    assert not schema_memo.known_valid(pilot._schema_text(), {"start": {}})
+    assert not schema_memo.known_valid(pilot._schema_text(), script.start)
+    calls = []
+    real = jsonschema.Draft202012Validator
+    monkeypatch.setattr(jsonschema, "Draft202012Validator",
+                        lambda *a, **k: calls.append(1) or real(*a, **k))
+    pilot.load(paths.repo_root() / "sim" / "pilots" / "default.yaml")
+    assert calls  # validated again: nothing was remembered
+
+    def unsearchable(_path):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(Path, "is_file", unsearchable)  # validated/ may not be looked into
+    calls.clear()
+    assert not schema_memo.known_valid(pilot._schema_text(), script.start)
+    pilot.load(paths.repo_root() / "sim" / "pilots" / "default.yaml")
+    assert calls

@@ -247,3 +247,19 @@ def test_the_c_writes_a_flight_data_recording_as_the_python_does(tmp_path, monke
     monkeypatch.setattr(fast, "fdr", spy)
     _record(run, tmp_path / "spy.mcap", True, monkeypatch)
     assert len(calls) == 3, calls  # the two start records and the HM record: the rest is the C's
+
+
+def test_traces_whose_last_line_was_cut_are_recorded_as_the_python_does(tmp_path, monkeypatch):
+    """A last line without its newline (its writer killed): the C hands it back at the end of
+    the block; the same file, the same line counted as skipped."""
+    run = tmp_path / "run"
+    _traces(run, random.Random(9))
+    whole = write.record(run, output=tmp_path / "whole.mcap", nodes=["node1"])["skipped_lines"]
+    for name, keep in (("can.jsonl", -1), ("node1.jsonl", -20)):
+        text = (run / name).read_bytes()
+        (run / name).write_bytes(text[:keep])
+    c_file = _record(run, tmp_path / "c.mcap", True, monkeypatch)
+    py_file = _record(run, tmp_path / "py.mcap", False, monkeypatch)
+    assert c_file == py_file
+    cut = write.record(run, output=tmp_path / "cut.mcap", nodes=["node1"])["skipped_lines"]
+    assert cut["node1.jsonl"] == whole["node1.jsonl"] + 1  # the line cut in its middle

@@ -4,8 +4,9 @@
  *
  * The recorder turns every line of the bus's trace (can.jsonl) and of each SKE's trace
  * (nodeK.jsonl) into MCAP messages: a CAN frame becomes a /can/frames message and a message of
- * its decoded signals; an SKE line goes as it is to its node's schedule, hm or events topic.
- * That is most of a recording's messages. This code does, for the lines in the form the bus
+ * its decoded signals; an SKE line goes as it is to its node's schedule, hm or events topic;
+ * a flight data recorder's frame record becomes its JSON (tm_fdr). That is most of a
+ * recording's messages. This code does, for the lines in the form the bus
  * and the SKE write, exactly what the recorder's Python does (python/ima/recording/topics.py),
  * byte for byte; any other line (a cut or garbled one, an event, a frame of an id it has not
  * been told about) it hands back to the Python, which handles it and tells it what it learned
@@ -34,7 +35,8 @@ typedef struct {
 tm_conv_t *tm_new(int kind);
 void tm_free(tm_conv_t *c);
 
-/* A topic's MCAP channel: TM_CAN_FRAMES, or an SKE trace's TM_SKE_*. 0 = none yet. */
+/* A topic's MCAP channel: TM_CAN_FRAMES, an SKE trace's TM_SKE_*, or a flight data
+ * recording's TM_FDR_RECORDS. 0 = none yet. */
 void tm_set_channel(tm_conv_t *c, int which, uint16_t cid);
 
 /* A DBC message (CAN): its length, the channel of its signals' topic (0 = none yet, then
@@ -64,8 +66,6 @@ int tm_convert(tm_conv_t *c, const uint8_t *text, size_t len, uint64_t seq, uint
 size_t tm_channels(const tm_conv_t *c, const uint16_t **cids);
 size_t tm_entries(const tm_conv_t *c, uint16_t cid, const uint64_t **pairs);
 
-/* A finite double as orjson writes it (shortest round trip: 12.34, 1e-7, 1e+16); its length
- * (at most 32 bytes, no terminating NUL), 0 for a NaN or an infinity. */
 /* A flight data recorder file's records (TM_FDR converter; partitions/fdr/fdr.h: fixed
  * 320-byte records, each a header, a body and a CRC-32): of the file's `n` whole records at
  * `data`, those from record `from` on, the first good one numbered `seq`, as messages of the
@@ -74,10 +74,13 @@ size_t tm_entries(const tm_conv_t *c, uint16_t cid, const uint64_t **pairs);
  * torn frame record (bad magic, version, length or CRC) or one of no kind is skipped.
  * `r->consumed` is the record reached, `r->lines` the good records out. It hands back
  * (TM_PYTHON) the record at `consumed` if it is a start or a health-monitor record (the Python
- * judges whether it is torn) or while it has no channel; TM_FULL once `room` bytes are out. */
+ * judges whether it is torn) or while it has no channel; TM_FULL once `room` bytes are out
+ * (after at least one record). TM_NOMEM, nothing done, on a converter of another kind. */
 int tm_fdr(tm_conv_t *c, const uint8_t *data, size_t n, size_t from, uint64_t seq,
            uint64_t base, uint64_t room, tm_result_t *r);
 
+/* A finite double as orjson writes it (shortest round trip: 12.34, 1e-7, 1e+16); its length
+ * (at most 32 bytes, no terminating NUL), 0 for a NaN or an infinity. */
 size_t tm_format_double(double x, char *buf);
 
 #endif

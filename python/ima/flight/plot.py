@@ -27,7 +27,9 @@ def plot_flight(truth: list[dict], segments: list[HoldSegment], out: Path, title
     """`events`: (time s, label) marked on every panel, e.g. a node killed, a replica voted out."""
     events = sorted(events or [])
     t = [r["t_ns"] / 1e9 for r in truth]
-    x0, x1 = (min(t[0], 0.0), t[-1]) if t else (0.0, 1.0)
+    # the flight and every event (one after the truth's end, of a run cut short, widens it)
+    xs = t[:1] + t[-1:] + [te for te, _ in events]
+    x0, x1 = (min(min(xs), 0.0), max(xs)) if xs else (0.0, 1.0)
     canvas = Canvas(WIDTH, HEIGHT)
     height = (BOTTOM - TOP - GAP * (len(PANELS) - 1)) / len(PANELS)
     panels = []

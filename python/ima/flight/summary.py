@@ -65,6 +65,8 @@ def read_jsonl(path: Path, needle: str | tuple[str, ...] | None = None) -> Itera
         return
     needles = None if needle is None else \
         tuple(n.encode() for n in ((needle,) if isinstance(needle, str) else needle))
+    if needles is not None and not all(needles):
+        needles = None  # an empty needle is in every line
     with f:
         rest = b""
         while True:

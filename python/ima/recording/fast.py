@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The recording's bulk in C: the bus's trace (can.jsonl) and each SKE's trace (nodeK.jsonl)
-turned into MCAP messages by nodes/src/trace_mcap.c (ctypes on libima_trace_mcap.so), written
-straight into the chunk being built. They are nine tenths of a recording's messages, and
-the Python costs a few microseconds for each.
+"""The recording's bulk in C: the bus's trace (can.jsonl) and each SKE's trace (nodeK.jsonl),
+handed over a block at a time as read, and the flight data recorders' frame records, turned
+into MCAP messages by nodes/src/trace_mcap.c and trace_mcap_fdr.c (ctypes on
+libima_trace_mcap.so), written straight into the chunk being built. They are nine tenths of a
+recording's messages, and the Python costs a few microseconds for each.
 
 The C writes what Topics.can and Topics.ske write, byte for byte (tests/recording/
 test_fast.py compares whole recordings). A line it does not handle (an event, a cut or garbled
@@ -15,7 +16,6 @@ The library is $IMA_TRACE_MCAP_LIB, else <build dir>/nodes/libima_trace_mcap.so.
 from __future__ import annotations
 
 import ctypes
-import itertools
 import os
 from array import array
 from collections.abc import Callable, Iterable
@@ -31,7 +31,6 @@ TM_CAN, TM_SKE, TM_FDR = 1, 2, 3
 TM_DONE, TM_PYTHON, TM_FULL = 0, 1, 2
 TM_CAN_FRAMES, TM_SKE_SCHEDULE, TM_SKE_HM, TM_SKE_OTHER, TM_FDR_RECORDS = 0, 0, 1, 2, 0
 FDR_RECORD = 320  # partitions/fdr/fdr.h (ima.fdr.records.RECORD_SIZE)
-BATCH_LINES = 50_000  # a whole trace is converted this many lines at a time
 
 Lines = Iterable[tuple[int, bytes]]
 
@@ -109,11 +108,6 @@ class _Converter:
     def learn(self) -> None:  # what Topics has registered since
         pass
 
-    def __call__(self, lines: Lines) -> None:
-        it = iter(lines)
-        while batch := list(itertools.islice(it, BATCH_LINES)):
-            self._batch(batch)
-
     def block(self, block: Block) -> None:
         """A block of the trace's lines as read (recording/follow.py), handed to the C as it
         is: only the lines the C hands back are split out."""
@@ -138,35 +132,6 @@ class _Converter:
                 self.python([(num, data[pos:end])])
                 self.learn()
                 pos, num = end + 1, num + 1
-
-    def _batch(self, lines: list[tuple[int, bytes]]) -> None:
-        if lines[-1][0] - lines[0][0] != len(lines) - 1:  # not numbered in a row: never so
-            self.python(lines)
-            self.learn()
-            return
-        text = b"\n".join([line for _, line in lines]) + b"\n"
-        buf = ctypes.create_string_buffer(text, len(text))
-        base_addr = ctypes.addressof(buf)
-        lib, conv, res, w = self.lib, self.conv, self._res, self.out.w
-        pos = k = skip = 0
-        while k < len(lines):
-            used = w.chunk_used()
-            rc = lib.tm_convert(conv, base_addr + pos, len(text) - pos, lines[k][0], used,
-                                max(0, w.chunk_bytes - used), skip, ctypes.byref(res))
-            if rc < 0:
-                raise MemoryError("trace_mcap: out of memory")
-            if res.out_len:
-                w.add_records(ctypes.string_at(res.out, res.out_len), self._entries())
-            pos += res.consumed
-            k += res.lines
-            skip = 0
-            if rc == TM_FULL:
-                skip = res.part
-            elif rc == TM_PYTHON and k < len(lines):
-                self.python(lines[k:k + 1])
-                self.learn()
-                pos += len(lines[k][1]) + 1
-                k += 1
 
     def _entries(self) -> list[tuple[int, array]]:
         """The last call's index entries, channel by channel in the order of each one's first
@@ -292,7 +257,8 @@ def fdr(out, topic: str, data: bytes, python: Callable[[int, int], bool]) -> boo
 
 class FastTopics(Topics):
     """Topics writing into an MCAP file (write.py's _Out) with the bus's and the SKEs' lines
-    converted by the C."""
+    converted by the C: the blocks its traces() feeds take (fed lines, can() and ske() are
+    Topics', in Python)."""
 
     def __init__(self, out, lib: ctypes.CDLL) -> None:
         super().__init__(out)
@@ -317,12 +283,6 @@ class FastTopics(Topics):
         if conv is None:
             conv = self._ske[node] = SkeConverter(self._lib, self.out, self, node)
         return conv
-
-    def can(self, lines: Lines) -> None:
-        self._can_converter()(lines)
-
-    def ske(self, node: str, lines: Lines) -> None:
-        self._ske_converter(node)(lines)
 
     def _can_block(self, block: Block) -> None:
         self._can_converter().block(block)

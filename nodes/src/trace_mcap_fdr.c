@@ -126,6 +126,22 @@ static const char *const MISSION_INTS[] = {",\"mode\":", ",\"lat_mode\":", ",\"v
 static const char *const MISSION_DBLS[] = {",\"hdg_deg\":", ",\"alt_ft\":", ",\"ias_kt\":",
                                            ",\"vs_fpm\":"};
 
+/* A frame record's three messages, in their order in its body: the key, the valid bit, the
+ * fields, the size (records.py: NAV, STATUS, MISSION). */
+static const struct {
+    const char *key;
+    uint32_t have;
+    const char *const *ints;
+    int n_int;
+    const char *const *dbls;
+    int n_dbl;
+    size_t size;
+} PARTS[] = {
+    {",\"nav\":", HAVE_NAV, NAV_INTS, 2, NAV_DBLS, 12, 112},
+    {",\"status\":", HAVE_STATUS, STATUS_INTS, 8, STATUS_DBLS, 4, 72},
+    {",\"mission\":", HAVE_MISSION, MISSION_INTS, 4, MISSION_DBLS, 4, 56},
+};
+
 /* The JSON of a good frame record at file offset `off`; its length. */
 static size_t frame_json(const uint8_t *rec, uint64_t off, char *buf)
 {
@@ -137,23 +153,14 @@ static size_t frame_json(const uint8_t *rec, uint64_t off, char *buf)
     put_u(&o, ",\"offset\":", off);
     put_u(&o, ",\"frame\":", u32(body));
     const uint8_t *p = body + 8;
-    lit(&o, ",\"nav\":");
-    if (valid & HAVE_NAV)
-        object(&o, p, NAV_INTS, 2, NAV_DBLS, 12);
-    else
-        lit(&o, "null");
-    p += 112;
-    lit(&o, ",\"status\":");
-    if (valid & HAVE_STATUS)
-        object(&o, p, STATUS_INTS, 8, STATUS_DBLS, 4);
-    else
-        lit(&o, "null");
-    p += 72;
-    lit(&o, ",\"mission\":");
-    if (valid & HAVE_MISSION)
-        object(&o, p, MISSION_INTS, 4, MISSION_DBLS, 4);
-    else
-        lit(&o, "null");
+    for (size_t i = 0; i < sizeof PARTS / sizeof PARTS[0]; i++) {
+        lit(&o, PARTS[i].key);
+        if (valid & PARTS[i].have)
+            object(&o, p, PARTS[i].ints, PARTS[i].n_int, PARTS[i].dbls, PARTS[i].n_dbl);
+        else
+            lit(&o, "null");
+        p += PARTS[i].size;
+    }
     lit(&o, "}");
     return (size_t)(o.p - buf);
 }

@@ -46,7 +46,7 @@ def main(argv: Sequence[str] | None = None, exit_process: bool = False) -> int:
     """Runs the command; its exit status. With `exit_process` (the process's entry point,
     ima.__main__), a command whose module sets FAST_EXIT ends the process as soon as it is
     done: what it started has ended and what it wrote is closed, so the interpreter's teardown
-    (freeing every module and object, about 0.1 s once matplotlib and numpy are loaded) is
+    (freeing every module and object, some 0.1 s once numpy and the like are loaded) is
     skipped."""
     args = build_parser().parse_args(argv)
     code = _run(args)

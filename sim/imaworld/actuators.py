@@ -235,10 +235,8 @@ class Actuators:
         ov = self.override
         moves = self._moves
         if moves[0] != dt_s:
-            p = self.p
             # the most each one moves in a step: (rate * dt), as computed below with an override
-            moves = self._moves = (dt_s, tuple((p.throttle_rate if i == 3 else p.surface_rate)
-                                               * dt_s for i in range(4)))
+            moves = self._moves = (dt_s, tuple(self.rate(i) * dt_s for i in range(4)))
         for i, m in enumerate(moves[1]):
             tgt = target[i]
             if tgt < lo[i]:

@@ -30,7 +30,6 @@ from ima.recording.topics import Topics
 TM_CAN, TM_SKE, TM_FDR = 1, 2, 3
 TM_DONE, TM_PYTHON, TM_FULL = 0, 1, 2
 TM_CAN_FRAMES, TM_SKE_SCHEDULE, TM_SKE_HM, TM_SKE_OTHER, TM_FDR_RECORDS = 0, 0, 1, 2, 0
-FDR_RECORD = 320  # partitions/fdr/fdr.h (ima.fdr.records.RECORD_SIZE)
 
 Lines = Iterable[tuple[int, bytes]]
 
@@ -117,12 +116,9 @@ class _Converter:
         pos, num, skip = 0, block.first, 0
         while pos < len(data):
             used = w.chunk_used()
-            rc = lib.tm_convert(conv, addr + pos, len(data) - pos, num, used,
-                                max(0, w.chunk_bytes - used), skip, ctypes.byref(res))
-            if rc < 0:
-                raise MemoryError("trace_mcap: out of memory")
-            if res.out_len:
-                w.add_records(ctypes.string_at(res.out, res.out_len), self._entries())
+            rc = self._taken(lib.tm_convert(conv, addr + pos, len(data) - pos, num, used,
+                                            max(0, w.chunk_bytes - used), skip,
+                                            ctypes.byref(res)))
             pos += res.consumed
             num += res.lines
             skip = res.part if rc == TM_FULL else 0
@@ -132,6 +128,15 @@ class _Converter:
                 self.python([(num, data[pos:end])])
                 self.learn()
                 pos, num = end + 1, num + 1
+
+    def _taken(self, rc: int) -> int:
+        """A call's answer, its records put into the chunk being built."""
+        if rc < 0:
+            raise MemoryError("trace_mcap: out of memory")
+        res = self._res
+        if res.out_len:
+            self.out.w.add_records(ctypes.string_at(res.out, res.out_len), self._entries())
+        return rc
 
     def _entries(self) -> list[tuple[int, array]]:
         """The last call's index entries, channel by channel in the order of each one's first
@@ -221,6 +226,33 @@ class SkeConverter(_Converter):
                 del self.topics[which]
 
 
+class FdrConverter(_Converter):
+    """A flight data recorder file's records (fdr())."""
+
+    def __init__(self, lib: ctypes.CDLL, out) -> None:
+        super().__init__(lib, TM_FDR, out, None)
+
+    def __call__(self, topic: str, data: bytes, python: Callable[[int, int], bool]) -> None:
+        """The file's records as fdr() says."""
+        from ima.fdr.records import RECORD_SIZE
+
+        n = len(data) // RECORD_SIZE
+        addr = ctypes.cast(ctypes.c_char_p(data), ctypes.c_void_p)  # read only, no copy
+        lib, conv, res, out = self.lib, self.conv, self._res, self.out
+        k = seq = 0
+        while k < n:
+            cid = out.channels.get(topic)
+            if cid:
+                lib.tm_set_channel(conv, TM_FDR_RECORDS, cid)
+            used = out.w.chunk_used()
+            rc = self._taken(lib.tm_fdr(conv, addr, n, k, seq, used,
+                                        max(0, out.w.chunk_bytes - used), ctypes.byref(res)))
+            k, seq = res.consumed, seq + res.lines
+            if rc == TM_PYTHON:
+                seq += python(k, seq)
+                k += 1
+
+
 def fdr(out, topic: str, data: bytes, python: Callable[[int, int], bool]) -> bool:
     """A flight data recorder file's records as messages of `topic` (write.py's _fdr): the
     frame records by the C, each record it hands back by `python(k, seq)` (record k, numbered
@@ -229,27 +261,9 @@ def fdr(out, topic: str, data: bytes, python: Callable[[int, int], bool]) -> boo
     lib = library()
     if lib is None:
         return False
-    conv = _Converter(lib, TM_FDR, out, None)
+    conv = FdrConverter(lib, out)
     try:
-        n = len(data) // FDR_RECORD
-        addr = ctypes.cast(ctypes.c_char_p(data), ctypes.c_void_p)  # read only, no copy
-        res, w = conv._res, out.w
-        k = seq = 0
-        while k < n:
-            cid = out.channels.get(topic)
-            if cid:
-                lib.tm_set_channel(conv.conv, TM_FDR_RECORDS, cid)
-            used = w.chunk_used()
-            rc = lib.tm_fdr(conv.conv, addr, n, k, seq, used, max(0, w.chunk_bytes - used),
-                            ctypes.byref(res))
-            if rc < 0:
-                raise MemoryError("trace_mcap: out of memory")
-            if res.out_len:
-                w.add_records(ctypes.string_at(res.out, res.out_len), conv._entries())
-            k, seq = res.consumed, seq + res.lines
-            if rc == TM_PYTHON:
-                seq += python(k, seq)
-                k += 1
+        conv(topic, data, python)
     finally:
         conv.close()
     return True

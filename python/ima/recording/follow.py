@@ -34,30 +34,17 @@ class Follow:
         self._tail = b""
         self._next = 0  # the number of the next complete line
 
-    def new_lines(self) -> list[tuple[int, bytes]]:
-        """(number, line without its newline) of every line completed since the last call;
-        nothing while the file does not exist."""
-        block = self._block(self._read(-1))
-        return block.lines() if block else []
-
     def new_block(self) -> Block | None:
-        """The lines completed since the last call (None: none)."""
+        """The lines completed since the last call (None: none, or no file yet)."""
         return self._block(self._read(-1))
 
     def blocks(self, size: int):
-        """Every line of a complete file, `size` bytes read at a time (a cut last line too):
-        lists of (number, line)."""
-        for block in self.raw_blocks(size):
-            yield block.lines()
-
-    def raw_blocks(self, size: int):
-        """Every line of a complete file, `size` bytes read at a time (a cut last line too):
-        Blocks."""
+        """Every line of a complete file, `size` bytes read at a time (a cut last line too)."""
         while data := self._read(size):
             block = self._block(data)
             if block:
                 yield block
-        yield from self.rest_blocks()
+        yield from self.rest()
 
     def _read(self, size: int) -> bytes:
         if self._f is None:
@@ -79,13 +66,9 @@ class Follow:
         self._next += block.data.count(b"\n")
         return block
 
-    def rest(self) -> list[tuple[int, bytes]]:
-        """The last line if its writer never ended it (a cut line: the reader skips and counts
-        it), once the file is complete; read first what new_lines() has not."""
-        return [line for block in self.rest_blocks() for line in block.lines()]
-
-    def rest_blocks(self) -> list[Block]:
-        """rest(), as blocks."""
+    def rest(self) -> list[Block]:
+        """Once the file is complete: what new_block() has not read, and the last line if its
+        writer never ended it (a cut line: the reader skips and counts it)."""
         blocks = [b for b in (self.new_block(),) if b]
         if self._tail:
             blocks.append(Block(self._next, self._tail))
@@ -112,7 +95,7 @@ def feed_until(traces: Iterable[tuple[Path, Callable[[Block], None]]], ended: Ca
                     feed(block)
             time.sleep(poll_s)
         for f, feed in follows:
-            for block in f.rest_blocks():
+            for block in f.rest():
                 feed(block)
     finally:
         for f, _ in follows:
@@ -124,7 +107,7 @@ def feed_all(traces: Iterable[tuple[Path, Callable[[Block], None]]], size: int) 
     for path, feed in traces:
         f = Follow(path)
         try:
-            for block in f.raw_blocks(size):
+            for block in f.blocks(size):
                 feed(block)
         finally:
             f.close()

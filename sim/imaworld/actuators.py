@@ -11,6 +11,7 @@ from .config import NS, ActuatorParams
 from .voter import Voter, mask_letters
 
 NORMAL, HOLD_LAST, SAFE = 0, 1, 2
+FOREVER = 1 << 62  # later than any instant of a run
 STATE_NAMES = ("NORMAL", "HOLD_LAST", "SAFE")
 CHANNELS = ("A", "B", "C")
 
@@ -46,6 +47,11 @@ class CommandSelector:
     def select(self, now_ns: int, stale_ns: int) -> tuple[tuple | None, str | None]:
         raise NotImplementedError
 
+    def holds_until(self, now_ns: int, stale_ns: int) -> int:
+        """After select(now_ns): the first instant at which select() may answer otherwise, no
+        command coming in meanwhile (an update() may change it at once)."""
+        return now_ns + 1
+
 
 class LowestLiveChannel(CommandSelector):
     """Use the lowest-lettered channel whose last command is fresh (simplex, before voting)."""
@@ -55,6 +61,14 @@ class LowestLiveChannel(CommandSelector):
             if t >= 0 and now_ns - t <= stale_ns:
                 return self.last_cmd[ch], CHANNELS[ch]
         return None, None
+
+    def holds_until(self, now_ns: int, stale_ns: int) -> int:
+        # the channel selected goes stale after stale_ns; a stale one comes back only with a
+        # command
+        for t in self.last_t:
+            if t >= 0 and now_ns - t <= stale_ns:
+                return t + stale_ns + 1
+        return FOREVER
 
 
 class VotingSelector(CommandSelector):
@@ -114,6 +128,9 @@ class VotingSelector(CommandSelector):
             self._vote(self.next_vote_t)
             self.next_vote_t += self.period_ns
         return self.cmd, self.label
+
+    def holds_until(self, now_ns: int, stale_ns: int) -> int:
+        return self.next_vote_t
 
     def _vote(self, tv: int) -> None:
         values: list[tuple | None] = [None] * self.n
@@ -181,6 +198,10 @@ class Actuators:
         # ("drive", position, rate): the actuator goes there at that rate, whatever the command.
         self.override: list | None = None
         self._moves: tuple = (None, ())  # (dt, each actuator's largest move in dt): step()
+        # The target of the last _target() and until when it holds (targeted()); -1: to be
+        # asked again (a command came in, or step() ran).
+        self.target: tuple = self.trim
+        self.until = -1
 
     def rate(self, i: int) -> float:
         """Actuator i's rate limit (normalised units per second)."""
@@ -197,6 +218,7 @@ class Actuators:
     def command(self, channel: int, t_ns: int, cmd: tuple) -> None:
         """An ACT_CMD frame of redundancy channel `channel` (0 = A) that ended at t_ns."""
         self.selector.update(channel, t_ns, cmd)
+        self.until = -1
 
     @property
     def ever_commanded(self) -> bool:
@@ -228,16 +250,36 @@ class Actuators:
             self.state, self.channel = state, ch
         return target
 
+    def targeted(self, now_ns: int) -> None:
+        """The target at now_ns (`target`), and until when it holds (`until`) if no command
+        comes in: what _target() would give at every instant from now_ns up to `until`, and
+        the transitions it would record, are those it gives and records at now_ns."""
+        self.target = self._target(now_ns)
+        sel = self.selector
+        if self.safe_latched or self.state == NORMAL:
+            until = FOREVER
+        elif not sel.commanded():
+            until = self.startup_ns + 1 if now_ns <= self.startup_ns else FOREVER
+        elif self.state == HOLD_LAST:
+            until = sel.newest_t() + self.stale_ns + self.hold_ns + 1
+        else:
+            until = FOREVER
+        self.until = max(min(until, sel.holds_until(now_ns, self.stale_ns)), now_ns + 1)
+
+    def moves(self, dt_s: float) -> tuple:
+        """The most each actuator moves in a step of dt_s: rate * dt (step() computes the same
+        with an override)."""
+        if self._moves[0] != dt_s:
+            self._moves = (dt_s, tuple(self.rate(i) * dt_s for i in range(4)))
+        return self._moves[1]
+
     def step(self, now_ns: int, dt_s: float) -> list[float]:
         """Move every actuator toward its target for one physics step starting at now_ns."""
         target = self._target(now_ns)
+        self.until = -1
         pos, lo, hi = self.pos, self.lo, self.hi
         ov = self.override
-        moves = self._moves
-        if moves[0] != dt_s:
-            # the most each one moves in a step: (rate * dt), as computed below with an override
-            moves = self._moves = (dt_s, tuple(self.rate(i) * dt_s for i in range(4)))
-        for i, m in enumerate(moves[1]):
+        for i, m in enumerate(self.moves(dt_s)):
             tgt = target[i]
             if tgt < lo[i]:
                 tgt = lo[i]

@@ -82,7 +82,8 @@ class Aircraft:
         pm = fdm.get_property_manager()
         self.node = {k: pm.get_node(v, False) for k, v in PROPS.items()}
         self.get = {k: n.get_double_value for k, n in self.node.items()}
-        self.ctl_set = tuple(pm.get_node(n, False).set_double_value for n in CONTROLS)
+        self.ctl_node = tuple(pm.get_node(n, False) for n in CONTROLS)
+        self.ctl_set = tuple(n.set_double_value for n in self.ctl_node)
         self._steer = pm.get_node("fcs/steer-cmd-norm", False).set_double_value
         self._brakes = (pm.get_node("fcs/left-brake-cmd-norm", False).set_double_value,
                         pm.get_node("fcs/right-brake-cmd-norm", False).set_double_value)

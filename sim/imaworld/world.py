@@ -14,12 +14,14 @@ from ima.canbus import proto
 from ima.canbus.client import BusError
 from ima.canbus.codec import BY_ID, MESSAGES, choices
 
+from . import stepper
 from .actuators import CHANNELS, Actuators, LowestLiveChannel, VotingSelector, safe_position
 from .config import DEFAULT, NS, VotingParams, WorldParams
 from .faults import WorldFaults
 from .faultspec import FaultSpec
 from .fdm import Aircraft
 from .landing import Ground
+from .physics import NEAR_GROUND_FT, Crash, Physics
 from .pilot import LAT_MODE_CODES, MODE_CODES, VERT_MODE_CODES, PilotScript
 from .pilot_model import PilotModel
 from .sensors import Ahrs, AirData, Gps, RadarAltimeter, cas_from_impact, static_pressure
@@ -41,7 +43,6 @@ _HANDLED = {MESSAGES[f"{name}_{c}"].frame_id: (kind, i, MESSAGES[f"{name}_{c}"].
             for kind, name in ((_ACT, "ACT_CMD"), (_BRAKE, "BRAKE_CMD"), (_STATUS, "FCS_STATUS"),
                                (_POS, "NAV_POS"), (_DATA, "NAV_DATA"))
             for i, c in enumerate(CHANNELS)}
-NEAR_GROUND_FT = 15.0  # below this height (of the centre of gravity) the wheels are watched
 # The world leaves the quanta before its next task ungranted (World._delivered) only this far
 # from every limit a crash is judged by, and for SKIP_MAX_NS at most: no aircraft gets from
 # there to a limit within that time, so a crash is found in the quantum it happens in, and the
@@ -54,10 +55,6 @@ SKIP_CAS_MARGIN_KT = 10.0
 SKIP_LOAD_MARGIN_G = 1.0
 FCS_MODES = choices("FCS_STATUS_A", "FCS_MODE_A")
 FCS_FALLBACKS = choices("FCS_STATUS_A", "FCS_FALLBACK_A")
-
-
-class Crash(Exception):
-    pass
 
 
 @dataclass
@@ -76,7 +73,9 @@ class Options:
     faults: list[FaultSpec] = field(default_factory=list)  # --fault, in command-line order
     # Test-only switches (--test-switch): "no-vote-out" makes the voter never vote a
     # channel out, to show that a campaign oracle can fail; "every-quantum" makes the world
-    # ask for every quantum (see World._delivered), to show that skipping them changes nothing.
+    # ask for every quantum (see World._delivered), to show that skipping them changes nothing;
+    # "python-steps" makes it step the physics in Python, to show that the C++ steps (stepper.py)
+    # change nothing.
     test_switches: tuple[str, ...] = ()
     # Mission plan images the station uplinks (--uplink T:FILE): [(t_ns, image)]
     uploads: list[tuple[int, bytes]] = field(default_factory=list)
@@ -100,7 +99,7 @@ def _named(counts: dict[int, int]) -> dict[str, int]:
     return dict(sorted(out.items()))
 
 
-class World:
+class World(Physics):
     """Everything outside the avionics. `bus` is a BusClient-like object (wait_tick, send,
     done, stop); the world is a LOCKSTEP client and runs until the bus stops or it crashes."""
 
@@ -178,6 +177,10 @@ class World:
                    start=script.start)
         self.faults = WorldFaults(opts.faults, self, params.faults) if opts.faults else None
         self._tasks = self._make_tasks()
+        # the physics steps in C++, unless the test switch python-steps asks for the Python's
+        # (or the module cannot drive this JSBSim: stepper.make says why)
+        self._stepper = (None if "python-steps" in opts.test_switches else
+                         stepper.make(self.ac, self.act, params.limits, NEAR_GROUND_FT, self.hz))
         self.skip_quanta = "every-quantum" not in opts.test_switches  # see _delivered()
         self._serving_t = 0  # the start of the quantum being served (the stop, at the end)
 
@@ -450,77 +453,6 @@ class World:
             else:
                 alt, wdir, wspd, _gs = decode(f.data)
                 pm.nav_data(ch, f.t_ns, alt, wdir, wspd)
-
-    # -- physics -------------------------------------------------------------------------
-    def advance(self, t: int) -> None:
-        """Run every physics step ending at or before t (the state is then at the last t_n <= t)."""
-        if self.next_step_t > t:
-            return
-        ac, act, g = self.ac, self.act, self.ac.get
-        run, set_controls, dt, hz = ac.run, ac.set_controls, self.dt, self.hz
-        lim = self.p.limits
-        max_roll, max_cas, max_load = lim.max_roll_deg, lim.max_cas_kt, lim.max_load_g
-        agl, phi, cas, nz = g["agl"], g["phi"], g["cas"], g["nz"]
-        ground = self.ground
-        step = act.step
-        n = self.n
-        while self.next_step_t <= t:
-            pos = step(n * NS // hz, dt)
-            set_controls(pos[0], pos[1], pos[2], pos[3])
-            run()
-            n += 1
-            self.next_step_t = (n + 1) * NS // hz
-            self.n = n
-            self.t_now = n * NS // hz
-            a, r = agl(), phi()
-            if not a > 0.0 or not -max_roll <= r <= max_roll:
-                if a != a or r != r:
-                    self._crash("state is not a number")
-                self._crash("ground contact" if a <= 0.0 else f"roll {r:.1f} deg")
-            c, z = cas(), nz()
-            # the load factor counts in the air: on the wheels the gear's springs give spikes
-            if not c <= max_cas or not (abs(z) <= max_load
-                                        or (ground.touchdown is not None and a < NEAR_GROUND_FT)):
-                self._crash(f"airspeed {c:.1f} kt" if not c <= max_cas
-                            else f"load factor {z:.1f} g")
-            if a < NEAR_GROUND_FT:
-                self._near_ground(ground, a, r, pos, dt)
-        self._log_actuators()
-
-    def _near_ground(self, ground: Ground, agl_ft: float, roll_deg: float, pos, dt: float) -> None:
-        """The wheels near the ground: steering, brakes, touchdown, bounces, the stop."""
-        g = self.ac.get
-        self.ac.set_ground_controls(pos[2], ground.brake_step(self.t_now, dt))
-        vn, ve = g["vn"](), g["ve"]()
-        why = ground.step(self.t_now, g["wow_l"]() > 0.5 or g["wow_r"]() > 0.5, agl_ft,
-                          -g["hdot"](), roll_deg, g["theta"](),
-                          math.hypot(vn, ve) / 1.6878098571011957, g["lat"](), g["lon"]())
-        for t, kind, f in ground.events[self._ground_ev_done:]:
-            self.event("gear", kind, t_ns=t, **f)
-        self._ground_ev_done = len(ground.events)
-        if why is not None:
-            self._crash(why)
-
-    def _log_actuators(self) -> None:
-        """Actuator state changes and the voter's events, in time order (a vote before the
-        state change it causes)."""
-        act = self.act
-        votes = getattr(act.selector, "events", ())
-        if len(act.transitions) == self._act_trans_done and len(votes) == self._vote_ev_done:
-            return
-        out = [(t, 0, i, kind, f) for i, (t, kind, f) in
-               enumerate(votes[self._vote_ev_done:])]
-        out += [(t, 1, i, "actuator_state", {"state": state, "channel": ch}) for i, (t, state, ch)
-                in enumerate(act.transitions[self._act_trans_done:])]
-        out.sort(key=lambda e: e[:3])
-        for t, _, _, kind, f in out:
-            self.event("actuators", kind, t_ns=t, **f)
-        self._act_trans_done = len(act.transitions)
-        self._vote_ev_done = len(votes)
-
-    def _crash(self, reason: str) -> None:
-        self.crash = (self.t_now, reason)
-        raise Crash(reason)
 
     # -- skipped quanta ------------------------------------------------------------------
     # Far from the limits of a crash, the world asks for no quantum before its next task (its

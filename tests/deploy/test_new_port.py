@@ -20,7 +20,7 @@ from ima.launch import run as launch_run
 
 ROOT = Path(__file__).resolve().parents[2]
 SOURCES = ("CMakeLists.txt", "bench", "config", "faultinject", "health_monitor", "nodes",
-           "partitions", "python", "ske", "tests")
+           "partitions", "python", "ske", "sim", "tests")
 
 MODEL_EDIT = {
     # io's ports: a new source port

@@ -1,0 +1,105 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The physics steps in C++ (sim/core/stepper.cc, imaworld.stepper): built and used, and the
+same flights to the byte as the Python's steps (--test-switch python-steps), through what
+sends the steps back to the Python: actuator targets that change (commands, stale commands,
+hold and safe, votes), faults that drive an actuator, steps near the ground and crashes."""
+
+from __future__ import annotations
+
+import math
+import sys
+
+import pytest
+from conftest_helpers import NS
+
+from imaworld import stepper
+from imaworld.faultspec import parse
+
+START = {"lat_deg": 47.0, "lon_deg": 8.0, "altitude_ft": 3000, "airspeed_kt": 100,
+         "heading_deg": 90}
+LOW = {**START, "altitude_ft": 650}  # 150 ft above the default terrain
+
+
+def both(local_world, *args, **kw):
+    """The same flight with the C++ steps and with the Python's: (c++ run, python run)."""
+    c = local_world(*args, **kw)
+    p = local_world(*args, test_switches=("python-steps",), **kw)
+    return c, p
+
+
+def assert_same(c, p):
+    assert c.world._stepper is not None and p.world._stepper is None
+    for name in ("truth.jsonl", "world.jsonl"):
+        assert (c.run_dir / name).read_bytes() == (p.run_dir / name).read_bytes(), name
+    sc, sp = c.summary(), p.summary()
+    sp.pop("test_switches")
+    assert sc == sp
+    assert c.bus.sent == p.bus.sent
+
+
+def test_the_module_is_built_and_drives_this_jsbsim():
+    assert stepper.module_path().is_file()
+    assert stepper._load() is not None, stepper._why_not
+
+
+def test_commands_that_stop_hold_then_go_safe(local_world):
+    def cmd(t, trim):
+        if t >= 3 * NS:
+            return None
+        return (trim[0] + 0.05 * math.sin(t / NS * 4),) + trim[1:]
+
+    c, p = both(local_world, "hold.yaml", 5, cmd=cmd)
+    assert_same(c, p)
+    states = [e["state"] for e in c.events() if e["kind"] == "actuator_state"]
+    assert states == ["NORMAL", "HOLD_LAST", "SAFE"]
+
+
+def test_voted_channels_one_voted_out(local_world):
+    def channel_cmd(ch, t, trim):
+        if ch == 2 and t >= 1 * NS:
+            return (trim[0] + 0.4,) + trim[1:]  # C disagrees from 1 s on
+        return (trim[0] + 0.02 * math.sin(t / NS * 3),) + trim[1:]
+
+    c, p = both(local_world, "hold.yaml", 3, channel_cmd=channel_cmd, channels=3)
+    assert_same(c, p)
+    assert [e["channel"] for e in c.events() if e["kind"] == "voted_out"] == ["C"]
+
+
+def test_actuator_faults_step_in_python_and_back(local_world):
+    specs = [parse("actuator_jam:fid=j,at=0.5s,period=1s,on=300ms,surface=elev"),
+             parse("actuator_hardover:fid=h,at=2s,until=2.5s,surface=ail,value=0.5")]
+    c, p = both(local_world, "hold.yaml", 3, cmd="trim", faults=specs)
+    assert_same(c, p)
+
+
+def test_a_roll_crash(local_world):
+    c, p = both(local_world, "hold.yaml", 20, cmd=lambda t, trim: (trim[0], 1.0, 0.0, trim[3]))
+    assert_same(c, p)
+    assert c.summary()["reason"].startswith("roll")
+
+
+def test_a_dive_into_the_ground(local_world):
+    c, p = both(local_world, {"start": LOW, "events": []}, 20,
+                cmd=lambda t, trim: (0.3, trim[1], trim[2], trim[3]))
+    assert_same(c, p)
+    s = c.summary()
+    assert s["crashed"], s["reason"]
+    # the last second was flown near the ground: the steps there were judged in Python
+    assert min(t["agl_ft"] for t in c.truth()[-10:]) < 15
+
+
+def test_a_stepper_refuses_what_is_not_jsbsim(local_world):
+    r = local_world("hold.yaml", 0.1, cmd="trim")
+    mod, ac, act = stepper._load(), r.world.ac, r.world.act
+    lib = sys.modules[type(ac.fdm).__module__].__file__
+    args = [lib, ac.fdm, ac.ctl_node, ac.node["agl"], ac.node["phi"], ac.node["cas"],
+            ac.node["nz"], act.lo, act.hi, act.moves(1 / 120), 120, 60.0, 160.0, 3.8, 15.0]
+    mod.Stepper(*args)
+    for i, bad in ((1, object()), (1, ac.node["agl"]), (3, ac.fdm), (3, 1.5),
+                   (2, (ac.node["agl"],) * 3), (7, (0.0,) * 3)):
+        with pytest.raises((TypeError, ValueError)):
+            mod.Stepper(*args[:i], bad, *args[i + 1:])
+    with pytest.raises(ImportError):
+        mod.Stepper("/nonexistent/_jsbsim.so", *args[1:])
+    with pytest.raises(RuntimeError):
+        mod.Stepper.__new__(mod.Stepper).run(1, 0, [0.0] * 4, (0.0,) * 4, 0, False)

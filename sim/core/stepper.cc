@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The world's physics steps in C++ (Python module imaworld._stepper, loaded by
+// The world's physics steps in C++ (the Stepper of the Python module imaworld._core, used by
 // sim/imaworld/stepper.py): the smart actuators' rate limits, the controls handed to JSBSim,
 // JSBSim's step, and the watch on the crash limits, for every step up to an instant, in one
 // call. It drives the JSBSim of the `jsbsim` wheel, the very object the Python holds, through
@@ -10,36 +10,13 @@
 // (the Python's Actuators._target, at an instant the Python names), and after any step whose
 // state is near a crash limit or near the ground (the Python then judges that step itself).
 
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
-
-#include <dlfcn.h>
+#include "core.h"
 
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 #include <exception>
 
+namespace core {
 namespace {
-
-constexpr int64_t NS = 1000000000;
-constexpr const char *NODE = "FGPropertyNode";
-
-// What run() returns.
-enum : int { DONE = 0, TARGET = 1, JUDGE = 2 };
-
-// The exported C++ functions, as plain functions taking `this` first (Itanium C++ ABI).
-using run_fn = bool (*)(void *fdm);
-using get_fn = double (*)(const void *node);
-using set_fn = bool (*)(void *node, double value);
-
-struct Jsb {
-    run_fn run;
-    get_fn get;
-    set_fn set;
-    const void *vt_fdm;   // where an FGFDMExec's vtable pointer points
-    const void *vt_node;  // where an SGPropertyNode's vtable pointer points
-};
 
 struct Stepper {
     PyObject_HEAD
@@ -53,76 +30,6 @@ struct Stepper {
     double max_roll, max_cas, max_load, near_ground_ft;
     PyObject *keep;  // the Python objects owning what the pointers above point at
 };
-
-// The C++ object a jsbsim Python object of class `cls` wraps: the first of its fields
-// (the words after the object header, within the class's size) that points at an object
-// whose vtable is `vt`. Only objects of that class are looked into: their fields are
-// pointers or null, never a value that cannot be dereferenced.
-void *wrapped(PyObject *o, const char *cls, const void *vt)
-{
-    const char *name = Py_TYPE(o)->tp_name;
-    const char *dot = strrchr(name, '.');
-    if (strcmp(dot != nullptr ? dot + 1 : name, cls) == 0) {
-        void **words = reinterpret_cast<void **>(o);
-        size_t size = static_cast<size_t>(Py_TYPE(o)->tp_basicsize) / sizeof(void *);
-        for (size_t i = 2; i < size; i++) {
-            void *p = words[i];
-            if (p != nullptr && (reinterpret_cast<uintptr_t>(p) & 7) == 0 &&
-                *static_cast<void *const *>(p) == vt)
-                return p;
-        }
-    }
-    PyErr_Format(PyExc_TypeError, "%s is not a jsbsim %s wrapping a JSBSim object", name, cls);
-    return nullptr;
-}
-
-bool resolve(const char *lib_path, Jsb *j)
-{
-    void *h = dlopen(lib_path, RTLD_NOW | RTLD_NOLOAD);
-    if (h == nullptr) {
-        PyErr_Format(PyExc_ImportError, "JSBSim's library %s is not loaded", lib_path);
-        return false;
-    }
-    void *run = dlsym(h, "_ZN6JSBSim9FGFDMExec3RunEv");
-    void *get = dlsym(h, "_ZNK14SGPropertyNode14getDoubleValueEv");
-    void *set = dlsym(h, "_ZN14SGPropertyNode14setDoubleValueEd");
-    void *vt_fdm = dlsym(h, "_ZTVN6JSBSim9FGFDMExecE");
-    void *vt_node = dlsym(h, "_ZTV14SGPropertyNode");
-    dlclose(h);  // still loaded: the jsbsim module holds it
-    if (!run || !get || !set || !vt_fdm || !vt_node) {
-        PyErr_Format(PyExc_ImportError, "%s does not export the JSBSim functions needed",
-                     lib_path);
-        return false;
-    }
-    j->run = reinterpret_cast<run_fn>(run);
-    j->get = reinterpret_cast<get_fn>(get);
-    j->set = reinterpret_cast<set_fn>(set);
-    // A vtable pointer points past the offset-to-top and typeinfo words.
-    j->vt_fdm = static_cast<char *>(vt_fdm) + 2 * sizeof(void *);
-    j->vt_node = static_cast<char *>(vt_node) + 2 * sizeof(void *);
-    return true;
-}
-
-bool doubles(PyObject *seq, double out[4], const char *what)
-{
-    PyObject *fast = PySequence_Fast(seq, what);
-    if (fast == nullptr)
-        return false;
-    if (PySequence_Fast_GET_SIZE(fast) != 4) {
-        Py_DECREF(fast);
-        PyErr_Format(PyExc_ValueError, "%s: 4 values expected", what);
-        return false;
-    }
-    for (int i = 0; i < 4; i++) {
-        out[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(fast, i));
-        if (out[i] == -1.0 && PyErr_Occurred()) {
-            Py_DECREF(fast);
-            return false;
-        }
-    }
-    Py_DECREF(fast);
-    return true;
-}
 
 // Stepper(lib_path, fdm, controls, agl, phi, cas, nz, lo, hi, moves, hz,
 //         max_roll_deg, max_cas_kt, max_load_g, near_ground_ft)
@@ -145,9 +52,9 @@ int stepper_init(PyObject *self_, PyObject *args, PyObject *kw)
         PyErr_SetString(PyExc_ValueError, "the physics rate must be > 0");
         return -1;
     }
-    if (!resolve(lib, &s->jsb))
+    if (!jsb_resolve(lib, &s->jsb))
         return -1;
-    s->fdm = wrapped(fdm, "FGFDMExec", s->jsb.vt_fdm);
+    s->fdm = jsb_wrapped(fdm, "FGFDMExec", s->jsb.vt_fdm);
     if (s->fdm == nullptr)
         return -1;
     PyObject *fast = PySequence_Fast(ctl, "controls");
@@ -159,7 +66,7 @@ int stepper_init(PyObject *self_, PyObject *args, PyObject *kw)
         return -1;
     }
     for (int i = 0; i < 4; i++) {
-        s->ctl[i] = wrapped(PySequence_Fast_GET_ITEM(fast, i), NODE, s->jsb.vt_node);
+        s->ctl[i] = jsb_wrapped(PySequence_Fast_GET_ITEM(fast, i), NODE, s->jsb.vt_node);
         if (s->ctl[i] == nullptr) {
             Py_DECREF(fast);
             return -1;
@@ -167,11 +74,11 @@ int stepper_init(PyObject *self_, PyObject *args, PyObject *kw)
     }
     Py_DECREF(fast);
     const void *vt = s->jsb.vt_node;
-    if (!(s->agl = wrapped(agl, NODE, vt)) || !(s->phi = wrapped(phi, NODE, vt)) ||
-        !(s->cas = wrapped(cas, NODE, vt)) || !(s->nz = wrapped(nz, NODE, vt)))
+    if (!(s->agl = jsb_wrapped(agl, NODE, vt)) || !(s->phi = jsb_wrapped(phi, NODE, vt)) ||
+        !(s->cas = jsb_wrapped(cas, NODE, vt)) || !(s->nz = jsb_wrapped(nz, NODE, vt)))
         return -1;
-    if (!doubles(lo, s->lo, "lo") || !doubles(hi, s->hi, "hi") ||
-        !doubles(moves, s->move, "moves"))
+    if (!seq_doubles(lo, s->lo, 4, "lo") || !seq_doubles(hi, s->hi, 4, "hi") ||
+        !seq_doubles(moves, s->move, 4, "moves"))
         return -1;
     s->hz = hz;
     s->n = 0;
@@ -218,7 +125,7 @@ PyObject *stepper_run(PyObject *self_, PyObject *const *args, Py_ssize_t nargs)
         return nullptr;
     }
     double pos[4], tgt[4];
-    if (!doubles(pos_list, pos, "pos") || !doubles(args[3], tgt, "target"))
+    if (!seq_doubles(pos_list, pos, 4, "pos") || !seq_doubles(args[3], tgt, 4, "target"))
         return nullptr;
     const Jsb &j = s->jsb;
     int code = DONE;
@@ -293,7 +200,7 @@ PyObject *stepper_get(PyObject *self_, PyObject *node)
         PyErr_SetString(PyExc_RuntimeError, "the Stepper was not set up");
         return nullptr;
     }
-    void *p = wrapped(node, NODE, s->jsb.vt_node);
+    void *p = jsb_wrapped(node, NODE, s->jsb.vt_node);
     if (p == nullptr)
         return nullptr;
     return PyFloat_FromDouble(s->jsb.get(p));
@@ -326,33 +233,9 @@ PyType_Slot stepper_slots[] = {
     {0, nullptr},
 };
 
-PyType_Spec stepper_spec = {"imaworld._stepper.Stepper", sizeof(Stepper), 0, Py_TPFLAGS_DEFAULT,
-                            stepper_slots};
-
-PyModuleDef module_def = {
-    PyModuleDef_HEAD_INIT, "_stepper", "The world's physics steps in C++.", -1,
-    nullptr, nullptr, nullptr, nullptr, nullptr,
-};
-
 }  // namespace
 
-PyMODINIT_FUNC PyInit__stepper(void);
+PyType_Spec stepper_spec = {"imaworld._core.Stepper", sizeof(Stepper), 0, Py_TPFLAGS_DEFAULT,
+                            stepper_slots};
 
-PyMODINIT_FUNC PyInit__stepper(void)
-{
-    PyObject *m = PyModule_Create(&module_def);
-    if (m == nullptr)
-        return nullptr;
-    PyObject *type = PyType_FromSpec(&stepper_spec);
-    bool bad = type == nullptr ||
-               PyModule_AddType(m, reinterpret_cast<PyTypeObject *>(type)) < 0 ||
-               PyModule_AddIntConstant(m, "DONE", DONE) < 0 ||
-               PyModule_AddIntConstant(m, "TARGET", TARGET) < 0 ||
-               PyModule_AddIntConstant(m, "JUDGE", JUDGE) < 0;
-    Py_XDECREF(type);  // the module holds its own reference
-    if (bad) {
-        Py_DECREF(m);
-        return nullptr;
-    }
-    return m;
-}
+}  // namespace core

@@ -13,7 +13,7 @@ from ima.errors import ImaError
 
 from .config import VotingParams
 
-TEST_SWITCHES = ("no-vote-out", "every-quantum", "python-steps")
+TEST_SWITCHES = ("no-vote-out", "every-quantum", "python-only")
 
 
 def _fault_classes() -> str:
@@ -64,9 +64,9 @@ def build_parser() -> argparse.ArgumentParser:
                     help="TEST ONLY: no-vote-out makes the actuators' voter never vote a "
                     "channel out (to show that a campaign oracle can fail); every-quantum makes "
                     "the world ask for every quantum of the bus, not only those a task of it "
-                    "falls in (to show that the quanta it skips change nothing); python-steps "
-                    "makes it step the physics in Python, not C++ (to show that the C++ steps "
-                    "change nothing)")
+                    "falls in (to show that the quanta it skips change nothing); python-only "
+                    "makes it run its Python where it has C++, the physics steps and the AHRS "
+                    "(to show that the C++ changes nothing)")
     ap.add_argument("--uplink", action="append", default=[], metavar="T:FILE",
                     help="uplink the mission plan image FILE (`ima mission` compiles one) over "
                     "the C2 link at T seconds; repeatable (a later plan replaces the earlier)")

@@ -27,18 +27,32 @@ _AIR_DATA = MESSAGES["AIR_DATA"]
 _RADALT = MESSAGES["RADALT"]
 
 
-def normal_stream(seed: int, name: str):
+def normal_stream(seed: int, name: str, core=None):
     """A function returning standard normal draws, one per call, from a numpy PCG64 generator
     seeded by (seed, name): each sensor has its own stream, so adding draws to one sensor does
-    not change another's. Draws come in blocks (far cheaper per value than random.gauss)."""
+    not change another's. Draws come in blocks (far cheaper per value than random.gauss).
+    With `core` (the module imaworld._core), a core.Normals over the same blocks: the same
+    draws, which the C++ can take too."""
     gen = np.random.Generator(np.random.PCG64(np.random.SeedSequence(
         [seed & 0xFFFFFFFFFFFFFFFF, zlib.crc32(name.encode())])))
 
+    def block():
+        return gen.standard_normal(4096).tolist()
+
+    if core is not None:
+        return core.Normals(block)
+
     def blocks():
         while True:
-            yield gen.standard_normal(4096).tolist()
+            yield block()
 
     return itertools.chain.from_iterable(blocks()).__next__
+
+
+def message_spec(m) -> tuple:
+    """A message's layout as the C++ encodes it (sim/core/codec.cc)."""
+    return (m.frame_id, m.length,
+            tuple((s.start, s.length, s.signed, s.scale, s.offset) for s in m.signals))
 
 
 class GaussMarkov:
@@ -124,11 +138,15 @@ class Gps:
 
 
 class Ahrs:
-    """Attitude and heading reference: AHRS_ATT, AHRS_RATE, AHRS_ACCEL at each sample."""
+    """Attitude and heading reference: AHRS_ATT, AHRS_RATE, AHRS_ACCEL at each sample.
 
-    def __init__(self, p: AhrsParams, seed: int) -> None:
+    With the C++ (`attach`), sample_now() reads the aircraft, draws and encodes in one call
+    (sim/core/ahrs.cc), the same as sample() with the aircraft's values; the counter, the
+    faults and the frames kept stay here."""
+
+    def __init__(self, p: AhrsParams, seed: int, core=None) -> None:
         self.p = p
-        self.n = rng = normal_stream(seed, "ahrs")
+        self.n = rng = normal_stream(seed, "ahrs", core)
         dt = p.period_ms / 1000.0
         gm = GaussMarkov
         self.b_att = [gm(rng, p.bias_sigma_att_deg, p.bias_tau_s, dt) for _ in range(2)]
@@ -137,8 +155,44 @@ class Ahrs:
         self.b_acc = [gm(rng, p.bias_sigma_accel_g, p.bias_tau_s, dt) for _ in range(3)]
         self.cnt = 0
         self.fault_ops: list | None = None  # set by the fault injectors (faults.py)
-        self.last_vals: tuple | None = None  # the values of the last frames sent
+        self._last_vals: tuple | None = None
+        self._last_in_core = False  # the last values are the C++'s (core.last())
         self.last_frames: list[tuple[int, bytes]] = []
+        self.core = None
+
+    @property
+    def last_vals(self) -> tuple | None:
+        """The values of the last frames sent."""
+        return self.core.last() if self._last_in_core else self._last_vals
+
+    @last_vals.setter
+    def last_vals(self, vals: tuple | None) -> None:
+        self._last_vals = vals
+        self._last_in_core = False
+
+    def attach(self, core, lib: str, nodes) -> None:
+        """Sample in C++ from now on (core: the module imaworld._core; nodes: the aircraft's
+        phi, theta, psi, p, q, r, ax, ay, az property nodes)."""
+        gms = [*self.b_att, self.b_hdg, *self.b_rate, *self.b_acc]
+        P = self.p
+        self.core = core.Ahrs(lib, nodes, self.n, [(g.a, g.q, g.x) for g in gms],
+                              (P.noise_att_deg, P.noise_hdg_deg, P.noise_rate_dps,
+                               P.noise_accel_g),
+                              [message_spec(m) for m in (_AHRS_ATT, _AHRS_RATE, _AHRS_ACCEL)])
+
+    def sample_now(self) -> list[tuple[int, bytes]]:
+        """sample() of the aircraft's values now, in C++ (after attach())."""
+        core = self.core
+        if self.fault_ops is None:
+            c = (self.cnt + 1) & 0xFF
+            out = core.frames(c)
+            if out is not None:
+                self.cnt = c
+                self.last_frames = out
+                self._last_in_core = True
+                return out
+            return self._emit(core.last())  # a value not finite: encoding it raises, as ever
+        return self._emit(core.vals())
 
     def sample(self, phi: float, theta: float, psi: float, p_: float, q: float, r: float,
                ax: float, ay: float, az: float) -> list[tuple[int, bytes]]:
@@ -161,6 +215,10 @@ class Ahrs:
                 r * DEG + br[2].step() + nr * n(),
                 ax + bc[0].step() + na * n(), ay + bc[1].step() + na * n(),
                 az + bc[2].step() + na * n())
+        return self._emit(vals)
+
+    def _emit(self, vals: tuple) -> list[tuple[int, bytes]]:
+        """The frames of a sample's values, faults applied, the counter counted."""
         fill = None
         if self.fault_ops is not None:
             vals, frames, fill = self._faulty(vals)

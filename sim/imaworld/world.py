@@ -14,7 +14,7 @@ from ima.canbus import proto
 from ima.canbus.client import BusError
 from ima.canbus.codec import BY_ID, MESSAGES, choices
 
-from . import stepper
+from . import core, stepper
 from .actuators import CHANNELS, Actuators, LowestLiveChannel, VotingSelector, safe_position
 from .config import DEFAULT, NS, VotingParams, WorldParams
 from .faults import WorldFaults
@@ -74,8 +74,8 @@ class Options:
     # Test-only switches (--test-switch): "no-vote-out" makes the voter never vote a
     # channel out, to show that a campaign oracle can fail; "every-quantum" makes the world
     # ask for every quantum (see World._delivered), to show that skipping them changes nothing;
-    # "python-steps" makes it step the physics in Python, to show that the C++ steps (stepper.py)
-    # change nothing.
+    # "python-only" makes it run its Python where it has C++ (core.py: the physics steps, the
+    # AHRS), to show that the C++ changes nothing.
     test_switches: tuple[str, ...] = ()
     # Mission plan images the station uplinks (--uplink T:FILE): [(t_ns, image)]
     uploads: list[tuple[int, bytes]] = field(default_factory=list)
@@ -121,6 +121,10 @@ class World(Physics):
             wind = (0.0, 270.0)
         self.wind = wind
         self.ac = Aircraft(params, script.start, seed, opts.terrain_ft, wind)
+        # the world's C++ (core.py), unless the test switch python-only asks for its Python
+        self._core = None if "python-only" in opts.test_switches else core.load()
+        if self._core is None and "python-only" not in opts.test_switches:
+            core.unavailable("stepping and sampling", core.why_not())
         self.trim = self.ac.trim()
         turb = opts.turbulence
         if turb not in params.atmosphere.turbulence:
@@ -133,7 +137,9 @@ class World(Physics):
                                             "no-vote-out" in opts.test_switches))
         self.ac.set_controls(*self.act.pos)
         self.gps = Gps(params.gps, seed, script.gps_augmentation)
-        self.ahrs = Ahrs(params.ahrs, seed)
+        self.ahrs = Ahrs(params.ahrs, seed, self._core)
+        if self._core is not None:
+            self._attach_sensors()
         self.adc = AirData(params.adc, seed)
         self.radalt = RadarAltimeter(params.radalt, seed)
         # station
@@ -177,10 +183,11 @@ class World(Physics):
                    start=script.start)
         self.faults = WorldFaults(opts.faults, self, params.faults) if opts.faults else None
         self._tasks = self._make_tasks()
-        # the physics steps in C++, unless the test switch python-steps asks for the Python's
-        # (or the module cannot drive this JSBSim: stepper.make says why)
-        self._stepper = (None if "python-steps" in opts.test_switches else
-                         stepper.make(self.ac, self.act, params.limits, NEAR_GROUND_FT, self.hz))
+        # the physics steps in C++ (or the module cannot drive this JSBSim: stepper.make says
+        # why on stderr)
+        self._stepper = (None if self._core is None else
+                         stepper.make(self._core, self.ac, self.act, params.limits,
+                                      NEAR_GROUND_FT, self.hz))
         self.skip_quanta = "every-quantum" not in opts.test_switches  # see _delivered()
         self._serving_t = 0  # the start of the quantum being served (the stop, at the end)
 
@@ -313,11 +320,24 @@ class World(Physics):
                 self.ac.set_wind(*self.wind)
                 self.event("world", "wind", speed_kt=self.wind[0], from_deg=self.wind[1])
 
+    def _attach_sensors(self) -> None:
+        """The sensors that sample in C++ (the same draws, the same frames)."""
+        node = self.ac.node
+        try:
+            self.ahrs.attach(self._core, core.jsbsim_library(self.ac.fdm),
+                             [node[k] for k in ("phi", "theta", "psi", "p", "q", "r",
+                                                "ax", "ay", "az")])
+        except (TypeError, ValueError, ImportError) as e:
+            core.unavailable("sampling the AHRS", str(e))
+
     def _gps(self, t: int) -> None:
         g = self.ac.get
         self._send(t, self.gps.sample(g["lat"](), g["lon"](), g["alt"](), g["vn"](), g["ve"]()))
 
     def _ahrs(self, t: int) -> None:
+        if self.ahrs.core is not None:
+            self._send(t, self.ahrs.sample_now())
+            return
         g = self.ac.get
         self._send(t, self.ahrs.sample(g["phi"](), g["theta"](), g["psi"](), g["p"](), g["q"](),
                                        g["r"](), g["ax"](), g["ay"](), g["az"]()))

@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The physics steps in C++ (sim/core/stepper.cc, imaworld.stepper): built and used, and the
-same flights to the byte as the Python's steps (--test-switch python-steps), through what
-sends the steps back to the Python: actuator targets that change (commands, stale commands,
-hold and safe, votes), faults that drive an actuator, steps near the ground and crashes."""
+"""The world's C++ (sim/core, imaworld.core): built and used, and the same flights to the byte
+as the world's Python (--test-switch python-only), through what sends the work back to the
+Python: actuator targets that change (commands, stale commands, hold and safe, votes), faults
+that drive an actuator or act on the AHRS, steps near the ground and crashes."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import sys
 import pytest
 from conftest_helpers import NS
 
-from imaworld import stepper
+from imaworld import core
 from imaworld.faultspec import parse
 
 START = {"lat_deg": 47.0, "lon_deg": 8.0, "altitude_ft": 3000, "airspeed_kt": 100,
@@ -23,12 +23,13 @@ LOW = {**START, "altitude_ft": 650}  # 150 ft above the default terrain
 def both(local_world, *args, **kw):
     """The same flight with the C++ steps and with the Python's: (c++ run, python run)."""
     c = local_world(*args, **kw)
-    p = local_world(*args, test_switches=("python-steps",), **kw)
+    p = local_world(*args, test_switches=("python-only",), **kw)
     return c, p
 
 
 def assert_same(c, p):
     assert c.world._stepper is not None and p.world._stepper is None
+    assert c.world.ahrs.core is not None and p.world.ahrs.core is None
     for name in ("truth.jsonl", "world.jsonl"):
         assert (c.run_dir / name).read_bytes() == (p.run_dir / name).read_bytes(), name
     sc, sp = c.summary(), p.summary()
@@ -37,9 +38,9 @@ def assert_same(c, p):
     assert c.bus.sent == p.bus.sent
 
 
-def test_the_module_is_built_and_drives_this_jsbsim():
-    assert stepper.module_path().is_file()
-    assert stepper._load() is not None, stepper._why_not
+def test_the_module_is_built_and_loads():
+    assert core.module_path().is_file()
+    assert core.load() is not None, core.why_not()
 
 
 def test_commands_that_stop_hold_then_go_safe(local_world):
@@ -72,6 +73,14 @@ def test_actuator_faults_step_in_python_and_back(local_world):
     assert_same(c, p)
 
 
+def test_ahrs_faults_take_the_values_from_the_cplusplus(local_world):
+    specs = [parse("ahrs_stuck:fid=s,at=0.5s,until=1s"),
+             parse("ahrs_stuck:fid=t,at=1.5s,until=2s,counter=frozen"),
+             parse("ahrs_bias:fid=b,at=1.2s,until=2.5s,axis=roll,value=5")]
+    c, p = both(local_world, "hold.yaml", 3, cmd="trim", faults=specs, seed=5)
+    assert_same(c, p)
+
+
 def test_a_roll_crash(local_world):
     c, p = both(local_world, "hold.yaml", 20, cmd=lambda t, trim: (trim[0], 1.0, 0.0, trim[3]))
     assert_same(c, p)
@@ -90,7 +99,7 @@ def test_a_dive_into_the_ground(local_world):
 
 def test_a_stepper_refuses_what_is_not_jsbsim(local_world):
     r = local_world("hold.yaml", 0.1, cmd="trim")
-    mod, ac, act = stepper._load(), r.world.ac, r.world.act
+    mod, ac, act = core.load(), r.world.ac, r.world.act
     lib = sys.modules[type(ac.fdm).__module__].__file__
     args = [lib, ac.fdm, ac.ctl_node, ac.node["agl"], ac.node["phi"], ac.node["cas"],
             ac.node["nz"], act.lo, act.hi, act.moves(1 / 120), 120, 60.0, 160.0, 3.8, 15.0]

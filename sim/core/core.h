@@ -1,0 +1,86 @@
+// SPDX-License-Identifier: Apache-2.0
+// What the world's C++ (the Python module imaworld._core, sim/core/*.cc) shares: JSBSim's
+// exported functions and the objects the jsbsim wheel wraps, a sequence read as doubles, and
+// the module's types.
+#pragma once
+
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <cstdint>
+
+namespace core {
+
+constexpr int64_t NS = 1000000000;
+constexpr const char *NODE = "FGPropertyNode";
+
+// What Stepper.run returns.
+enum : int { DONE = 0, TARGET = 1, JUDGE = 2 };
+
+// The exported C++ functions, as plain functions taking `this` first (Itanium C++ ABI).
+using run_fn = bool (*)(void *fdm);
+using get_fn = double (*)(const void *node);
+using set_fn = bool (*)(void *node, double value);
+
+struct Jsb {
+    run_fn run;
+    get_fn get;
+    set_fn set;
+    const void *vt_fdm;   // where an FGFDMExec's vtable pointer points
+    const void *vt_node;  // where an SGPropertyNode's vtable pointer points
+};
+
+// The functions of the jsbsim wheel's library `lib_path` (already loaded by the jsbsim module).
+bool jsb_resolve(const char *lib_path, Jsb *j);
+
+// The C++ object a jsbsim Python object of class `cls` (FGFDMExec, FGPropertyNode) wraps, its
+// vtable checked; nullptr with a TypeError set if it is not one.
+void *jsb_wrapped(PyObject *o, const char *cls, const void *vt);
+
+// n doubles from a sequence of exactly n numbers; false with an exception set otherwise.
+bool seq_doubles(PyObject *seq, double *out, Py_ssize_t n, const char *what);
+
+// A stream of standard normal draws (normals.cc): blocks from a Python callable.
+struct Normals {
+    PyObject_HEAD
+    PyObject *draw;  // draw() -> the next block, a sequence of floats
+    double *block;
+    Py_ssize_t i, n;
+};
+
+// Whether o is a Normals.
+bool is_normals(PyObject *o);
+
+// The next draw; false with an exception set if a new block cannot be had.
+bool normals_next(Normals *s, double *x);
+
+// One CAN message as ima.canbus.codec encodes it (codec.cc).
+constexpr int MSG_MAX_SIGNALS = 16;
+struct Sig {
+    int start, length;
+    bool is_signed;
+    double scale, offset;
+};
+struct Msg {
+    uint32_t id;
+    int length;
+    int nsig;
+    Sig sig[MSG_MAX_SIGNALS];
+};
+
+// spec: (frame_id, length, ((start, length, signed, scale, offset), ...)).
+bool msg_parse(PyObject *spec, Msg *m);
+// The message's bytes for the signals' values v (DBC order); false if a value is not finite
+// (the Python's round() raises then).
+bool msg_encode(const Msg *m, const double *v, uint8_t out[8]);
+// (frame_id, bytes); nullptr with no exception set if a value is not finite.
+PyObject *msg_frame(const Msg *m, const double *v);
+
+// Python's float % (the result has the divisor's sign).
+double py_mod(double x, double y);
+
+extern PyType_Spec stepper_spec;
+extern PyType_Spec normals_spec;
+extern PyType_Spec ahrs_spec;
+
+}  // namespace core

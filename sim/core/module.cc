@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: Apache-2.0
+// The Python module imaworld._core: the world's C++ (see sim/README.md, Speed), loaded by
+// sim/imaworld/core.py from the build tree.
+
+#include "core.h"
+
+namespace {
+
+PyModuleDef module_def = {
+    PyModuleDef_HEAD_INIT, "_core", "The world's C++: its physics steps and sensors.", -1,
+    nullptr, nullptr, nullptr, nullptr, nullptr,
+};
+
+bool add_type(PyObject *m, PyType_Spec *spec)
+{
+    PyObject *type = PyType_FromSpec(spec);
+    bool ok = type != nullptr && PyModule_AddType(m, reinterpret_cast<PyTypeObject *>(type)) == 0;
+    Py_XDECREF(type);  // the module holds its own reference
+    return ok;
+}
+
+}  // namespace
+
+PyMODINIT_FUNC PyInit__core(void);
+
+PyMODINIT_FUNC PyInit__core(void)
+{
+    PyObject *m = PyModule_Create(&module_def);
+    if (m == nullptr)
+        return nullptr;
+    if (!add_type(m, &core::stepper_spec) || !add_type(m, &core::normals_spec) ||
+        !add_type(m, &core::ahrs_spec) || PyModule_AddIntConstant(m, "DONE", core::DONE) < 0 ||
+        PyModule_AddIntConstant(m, "TARGET", core::TARGET) < 0 ||
+        PyModule_AddIntConstant(m, "JUDGE", core::JUDGE) < 0) {
+        Py_DECREF(m);
+        return nullptr;
+    }
+    return m;
+}

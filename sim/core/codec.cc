@@ -77,16 +77,4 @@ PyObject *msg_frame(const Msg *m, const double *v)
                          reinterpret_cast<const char *>(data), static_cast<Py_ssize_t>(m->length));
 }
 
-double py_mod(double x, double y)
-{
-    double m = std::fmod(x, y);
-    if (m != 0.0) {
-        if ((y < 0.0) != (m < 0.0))
-            m += y;
-    } else {
-        m = std::copysign(0.0, y);
-    }
-    return m;
-}
-
 }  // namespace core

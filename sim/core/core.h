@@ -76,11 +76,15 @@ bool msg_encode(const Msg *m, const double *v, uint8_t out[8]);
 // (frame_id, bytes); nullptr with no exception set if a value is not finite.
 PyObject *msg_frame(const Msg *m, const double *v);
 
-// Python's float % (the result has the divisor's sign).
+// Floats as the Python computes and writes them (pyfloat.cc): x % y; round(x, ndigits);
+// repr(x) of a finite x into out (at most 32 chars), its length returned.
 double py_mod(double x, double y);
+double py_round(double x, int ndigits);
+size_t py_repr(double x, char *out);
 
 extern PyType_Spec stepper_spec;
 extern PyType_Spec normals_spec;
 extern PyType_Spec ahrs_spec;
+extern PyType_Spec truth_spec;
 
 }  // namespace core

@@ -138,8 +138,6 @@ class World(Physics):
         self.ac.set_controls(*self.act.pos)
         self.gps = Gps(params.gps, seed, script.gps_augmentation)
         self.ahrs = Ahrs(params.ahrs, seed, self._core)
-        if self._core is not None:
-            self._attach_sensors()
         self.adc = AirData(params.adc, seed)
         self.radalt = RadarAltimeter(params.radalt, seed)
         # station
@@ -152,6 +150,9 @@ class World(Physics):
         self.uplink = Uplink(opts.uploads) if opts.uploads or script.has_mission else None
         self._uplink_ev_done = 0
         self.traffic = Traffic(script.traffic) if script.traffic else None
+        self._truth_core = None  # the truth lines in C++ (_attach_sensors)
+        if self._core is not None:
+            self._attach_sensors()
         self.ground = Ground()
         self._ground_ev_done = 0
         self._traffic_ev_done = 0
@@ -171,7 +172,6 @@ class World(Physics):
         self.t_end = 0
         self.events_f = open(self.run_dir / "world.jsonl", "w")
         self.truth_f = open(self.run_dir / "truth.jsonl", "w")
-        self.last_truth: dict | None = None
         self._act_trans_done = 0
         self._vote_ev_done = 0
         self._evt_idx = 0
@@ -321,14 +321,23 @@ class World(Physics):
                 self.event("world", "wind", speed_kt=self.wind[0], from_deg=self.wind[1])
 
     def _attach_sensors(self) -> None:
-        """The sensors that sample in C++ (the same draws, the same frames)."""
-        node = self.ac.node
+        """What samples and records in C++: the AHRS, and the truth without traffic (the same
+        draws, frames and lines)."""
+        node, lib = self.ac.node, core.jsbsim_library(self.ac.fdm)
         try:
-            self.ahrs.attach(self._core, core.jsbsim_library(self.ac.fdm),
-                             [node[k] for k in ("phi", "theta", "psi", "p", "q", "r",
-                                                "ax", "ay", "az")])
+            self.ahrs.attach(self._core, lib, [node[k] for k in ("phi", "theta", "psi", "p", "q",
+                                                                 "r", "ax", "ay", "az")])
         except (TypeError, ValueError, ImportError) as e:
             core.unavailable("sampling the AHRS", str(e))
+        if self.traffic is not None:
+            return
+        try:
+            self._truth_core = self._core.Truth(
+                lib, [node[k] for k in ("lat", "lon", "alt", "agl", "cas", "tas", "vn", "ve",
+                                        "psi", "phi", "theta", "hdot", "wind_n", "wind_e")],
+                math.hypot, math.atan2)
+        except (TypeError, ValueError, ImportError) as e:
+            core.unavailable("writing the truth", str(e))
 
     def _gps(self, t: int) -> None:
         g = self.ac.get
@@ -429,9 +438,15 @@ class World(Physics):
             pitch, roll, s["yaw"], thr, self.stk_cnt))])
 
     def _truth(self, t: int) -> None:
-        rec = self.truth()
-        self.last_truth = rec
-        self.truth_f.write(json.dumps(rec, separators=(",", ":")) + "\n")
+        tc = self._truth_core
+        if tc is not None:
+            mode, fb = self.fcs_mode()
+            line = tc.line(self.t_now, self.act.pos, mode, fb,
+                           "up" if self.link_up() else "down", self.gps.effective_state)
+            if line is not None:
+                self.truth_f.write(line)
+                return
+        self.truth_f.write(json.dumps(self.truth(), separators=(",", ":")) + "\n")
 
     def _status(self, t: int) -> None:
         g = self.ac.get

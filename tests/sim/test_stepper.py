@@ -12,6 +12,7 @@ import sys
 import pytest
 from conftest_helpers import NS
 
+from ima.canbus.codec import MESSAGES
 from imaworld import core
 from imaworld.faultspec import parse
 
@@ -30,6 +31,7 @@ def both(local_world, *args, **kw):
 def assert_same(c, p):
     assert c.world._stepper is not None and p.world._stepper is None
     assert c.world.ahrs.core is not None and p.world.ahrs.core is None
+    assert c.world._truth_core is not None and p.world._truth_core is None
     for name in ("truth.jsonl", "world.jsonl"):
         assert (c.run_dir / name).read_bytes() == (p.run_dir / name).read_bytes(), name
     sc, sp = c.summary(), p.summary()
@@ -81,6 +83,25 @@ def test_ahrs_faults_take_the_values_from_the_cplusplus(local_world):
     assert_same(c, p)
 
 
+def test_the_station_in_the_truth(local_world):
+    st = MESSAGES["FCS_STATUS_A"]
+
+    def downlink(t_from, t_until):  # FCS channel A reports AUTOPILOT, then DIRECT
+        if t_from % 50_000_000:
+            return []
+        mode = 2 if t_from < 2 * NS else 1
+        return [(t_from, st.frame_id, st.encode(mode, 2, 0, 7, 0, 0, 0, 1, 90.0, 3000))]
+
+    script = {"start": START, "events": [
+        {"t": 0, "mode": "DIRECT"}, {"t": 1, "c2_link": "down"}, {"t": 1.5, "gps": "frozen"},
+        {"t": 2.5, "c2_link": "up"}, {"t": 3, "gps": "lost"}]}
+    c, p = both(local_world, script, 4, cmd="trim", extra_injector=downlink)
+    assert_same(c, p)
+    modes = {t["fcs_mode"] for t in c.truth()}
+    assert {None, "AUTOPILOT", "DIRECT"} <= modes
+    assert {t["gps"] for t in c.truth()} == {"ok", "frozen", "lost"}
+
+
 def test_a_roll_crash(local_world):
     c, p = both(local_world, "hold.yaml", 20, cmd=lambda t, trim: (trim[0], 1.0, 0.0, trim[3]))
     assert_same(c, p)
@@ -95,6 +116,24 @@ def test_a_dive_into_the_ground(local_world):
     assert s["crashed"], s["reason"]
     # the last second was flown near the ground: the steps there were judged in Python
     assert min(t["agl_ft"] for t in c.truth()[-10:]) < 15
+
+
+def test_numbers_are_rounded_and_written_as_the_python_does():
+    import json
+    import random
+
+    from imaworld.world import _r
+
+    rnd = random.Random(7)
+    xs = [0.0, -0.0, 1e-4, 1e-5, 2.675, 1.005, 0.125, 1e15, 1e16, -5e-8, 4.9999999e-8,
+          math.inf, -math.inf, math.nan, 359.9995, -0.00004]
+    xs += [rnd.uniform(-1, 1) * 10 ** rnd.randint(-12, 18) for _ in range(20000)]
+    xs += [round(rnd.uniform(-400, 400), rnd.randint(0, 8)) + rnd.choice([5e-8, -5e-5, 5e-4])
+           for _ in range(20000)]
+    number = core.load().json_number
+    for x in xs:
+        for n in (1, 2, 3, 4, 7):
+            assert number(x, n) == json.dumps(_r(x, n)), (x, n)
 
 
 def test_a_stepper_refuses_what_is_not_jsbsim(local_world):

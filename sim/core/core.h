@@ -86,5 +86,6 @@ extern PyType_Spec stepper_spec;
 extern PyType_Spec normals_spec;
 extern PyType_Spec ahrs_spec;
 extern PyType_Spec truth_spec;
+extern PyType_Spec adc_spec;
 
 }  // namespace core

@@ -52,7 +52,8 @@ PyMODINIT_FUNC PyInit__core(void)
     if (m == nullptr)
         return nullptr;
     if (!add_type(m, &core::stepper_spec) || !add_type(m, &core::normals_spec) ||
-        !add_type(m, &core::ahrs_spec) || !add_type(m, &core::truth_spec) || PyModule_AddIntConstant(m, "DONE", core::DONE) < 0 ||
+        !add_type(m, &core::ahrs_spec) || !add_type(m, &core::truth_spec) ||
+        !add_type(m, &core::adc_spec) || PyModule_AddIntConstant(m, "DONE", core::DONE) < 0 ||
         PyModule_AddIntConstant(m, "TARGET", core::TARGET) < 0 ||
         PyModule_AddIntConstant(m, "JUDGE", core::JUDGE) < 0) {
         Py_DECREF(m);

@@ -291,15 +291,36 @@ def static_pressure(palt_ft: float) -> float:
 
 
 class AirData:
-    """Air data computer: AIR_DATA (calibrated airspeed, baro altitude, vertical speed)."""
+    """Air data computer: AIR_DATA (calibrated airspeed, baro altitude, vertical speed).
 
-    def __init__(self, p: AdcParams, seed: int) -> None:
+    With the C++ (`attach`), sample_now() reads the aircraft, draws and encodes in one call
+    (sim/core/adc.cc), the same as sample() with the aircraft's values."""
+
+    def __init__(self, p: AdcParams, seed: int, core=None) -> None:
         self.p = p
-        self.n = rng = normal_stream(seed, "adc")
+        self.n = rng = normal_stream(seed, "adc", core)
         dt = p.period_ms / 1000.0
         self.b_ias = GaussMarkov(rng, p.bias_sigma_ias_kt, p.bias_tau_s, dt)
         self.b_alt = GaussMarkov(rng, p.bias_sigma_alt_ft, p.bias_tau_s, dt)
         self.cnt = 0
+        self.core = None
+
+    def attach(self, core, lib: str, nodes) -> None:
+        """Sample in C++ from now on (nodes: the aircraft's cas, palt, hdot property nodes)."""
+        P = self.p
+        self.core = core.Adc(lib, nodes, self.n,
+                             [(g.a, g.q, g.x) for g in (self.b_ias, self.b_alt)],
+                             (P.noise_ias_kt, P.noise_alt_ft, P.noise_vs_fpm),
+                             message_spec(_AIR_DATA))
+
+    def sample_now(self, cas_kt: float | None = None) -> list[tuple[int, bytes]]:
+        """sample() of the aircraft's values now (cas_kt given: that airspeed), in C++."""
+        self.cnt = c = (self.cnt + 1) & 0xF
+        out = self.core.frames(c, cas_kt)
+        if out is None:  # a value not finite: encoding it raises, as ever
+            ias, alt, vs = self.core.last()
+            return [(_AIR_DATA.frame_id, _AIR_DATA.encode(ias, alt, vs, 1, c))]
+        return out
 
     def sample(self, cas_kt: float, palt_ft: float, hdot_fps: float) -> list[tuple[int, bytes]]:
         P, n = self.p, self.n

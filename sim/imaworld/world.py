@@ -138,7 +138,7 @@ class World(Physics):
         self.ac.set_controls(*self.act.pos)
         self.gps = Gps(params.gps, seed, script.gps_augmentation)
         self.ahrs = Ahrs(params.ahrs, seed, self._core)
-        self.adc = AirData(params.adc, seed)
+        self.adc = AirData(params.adc, seed, self._core)
         self.radalt = RadarAltimeter(params.radalt, seed)
         # station
         self.station = dict(script.initial)
@@ -321,14 +321,18 @@ class World(Physics):
                 self.event("world", "wind", speed_kt=self.wind[0], from_deg=self.wind[1])
 
     def _attach_sensors(self) -> None:
-        """What samples and records in C++: the AHRS, and the truth without traffic (the same
-        draws, frames and lines)."""
+        """What samples and records in C++: the AHRS, the air data, and the truth without
+        traffic (the same draws, frames and lines)."""
         node, lib = self.ac.node, core.jsbsim_library(self.ac.fdm)
         try:
             self.ahrs.attach(self._core, lib, [node[k] for k in ("phi", "theta", "psi", "p", "q",
                                                                  "r", "ax", "ay", "az")])
         except (TypeError, ValueError, ImportError) as e:
             core.unavailable("sampling the AHRS", str(e))
+        try:
+            self.adc.attach(self._core, lib, [node[k] for k in ("cas", "palt", "hdot")])
+        except (TypeError, ValueError, ImportError) as e:
+            core.unavailable("sampling the air data", str(e))
         if self.traffic is not None:
             return
         try:
@@ -353,8 +357,12 @@ class World(Physics):
 
     def _adc(self, t: int) -> None:
         g = self.ac.get
-        cas = g["cas"]()
         pt = self.faults.pitot_pt if self.faults else None
+        if self.adc.core is not None:
+            self._send(t, self.adc.sample_now(
+                None if pt is None else cas_from_impact(pt - static_pressure(g["palt"]()))))
+            return
+        cas = g["cas"]()
         if pt is not None:  # blocked pitot: the trapped total pressure against the static
             cas = cas_from_impact(pt - static_pressure(g["palt"]()))
         self._send(t, self.adc.sample(cas, g["palt"](), g["hdot"]()))

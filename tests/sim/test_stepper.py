@@ -32,6 +32,7 @@ def assert_same(c, p):
     assert c.world._stepper is not None and p.world._stepper is None
     assert c.world.ahrs.core is not None and p.world.ahrs.core is None
     assert c.world._truth_core is not None and p.world._truth_core is None
+    assert c.world.adc.core is not None and p.world.adc.core is None
     for name in ("truth.jsonl", "world.jsonl"):
         assert (c.run_dir / name).read_bytes() == (p.run_dir / name).read_bytes(), name
     sc, sp = c.summary(), p.summary()
@@ -75,10 +76,11 @@ def test_actuator_faults_step_in_python_and_back(local_world):
     assert_same(c, p)
 
 
-def test_ahrs_faults_take_the_values_from_the_cplusplus(local_world):
+def test_sensor_faults_with_the_cplusplus_samples(local_world):
     specs = [parse("ahrs_stuck:fid=s,at=0.5s,until=1s"),
              parse("ahrs_stuck:fid=t,at=1.5s,until=2s,counter=frozen"),
-             parse("ahrs_bias:fid=b,at=1.2s,until=2.5s,axis=roll,value=5")]
+             parse("ahrs_bias:fid=b,at=1.2s,until=2.5s,axis=roll,value=5"),
+             parse("pitot_blocked:fid=p,at=1s,until=2s")]
     c, p = both(local_world, "hold.yaml", 3, cmd="trim", faults=specs, seed=5)
     assert_same(c, p)
 

@@ -100,7 +100,7 @@ int adc_init(PyObject *self_, PyObject *args, PyObject *kw)
         return -1;
     bool ok = PySequence_Fast_GET_SIZE(fn) == NN;
     for (int k = 0; ok && k < NN; k++)
-        ok = (s->node[k] = jsb_wrapped(PySequence_Fast_GET_ITEM(fn, k), NODE, s->jsb.vt_node));
+        ok = (s->node[k] = jsb_node(s->jsb, PySequence_Fast_GET_ITEM(fn, k)));
     Py_DECREF(fn);
     if (!ok) {
         if (!PyErr_Occurred())
@@ -114,9 +114,11 @@ int adc_init(PyObject *self_, PyObject *args, PyObject *kw)
     for (int k = 0; ok && k < 2; k++) {
         double aqx[3];
         ok = seq_doubles(PySequence_Fast_GET_ITEM(fb, k), aqx, 3, "a bias (a, q, x)");
-        s->a[k] = aqx[0];
-        s->q[k] = aqx[1];
-        s->x[k] = aqx[2];
+        if (ok) {
+            s->a[k] = aqx[0];
+            s->q[k] = aqx[1];
+            s->x[k] = aqx[2];
+        }
     }
     Py_DECREF(fb);
     if (!ok) {
@@ -135,7 +137,8 @@ int adc_init(PyObject *self_, PyObject *args, PyObject *kw)
     s->noise_alt = nz[1];
     s->noise_vs = nz[2];
     s->n = reinterpret_cast<Normals *>(normals);
-    s->keep = Py_BuildValue("(OO)", normals, nodes);
+    PyObject *held = PySequence_Tuple(nodes);  // a copy: the nodes stay what was given
+    s->keep = held != nullptr ? Py_BuildValue("(ON)", normals, held) : nullptr;
     return s->keep != nullptr ? 0 : -1;
 }
 

@@ -161,7 +161,7 @@ int ahrs_init(PyObject *self_, PyObject *args, PyObject *kw)
         return -1;
     bool ok = PySequence_Fast_GET_SIZE(fn) == NV;
     for (int k = 0; ok && k < NV; k++)
-        ok = (s->node[k] = jsb_wrapped(PySequence_Fast_GET_ITEM(fn, k), NODE, s->jsb.vt_node));
+        ok = (s->node[k] = jsb_node(s->jsb, PySequence_Fast_GET_ITEM(fn, k)));
     Py_DECREF(fn);
     if (!ok) {
         if (!PyErr_Occurred())
@@ -175,9 +175,11 @@ int ahrs_init(PyObject *self_, PyObject *args, PyObject *kw)
     for (int k = 0; ok && k < NV; k++) {
         double aqx[3];
         ok = seq_doubles(PySequence_Fast_GET_ITEM(fb, k), aqx, 3, "a bias (a, q, x)");
-        s->a[k] = aqx[0];
-        s->q[k] = aqx[1];
-        s->x[k] = aqx[2];
+        if (ok) {
+            s->a[k] = aqx[0];
+            s->q[k] = aqx[1];
+            s->x[k] = aqx[2];
+        }
     }
     Py_DECREF(fb);
     if (!ok) {
@@ -206,7 +208,8 @@ int ahrs_init(PyObject *self_, PyObject *args, PyObject *kw)
     }
     s->n = reinterpret_cast<Normals *>(normals);
     s->has_last = false;
-    s->keep = Py_BuildValue("(OO)", normals, nodes);
+    PyObject *held = PySequence_Tuple(nodes);  // a copy: the nodes stay what was given
+    s->keep = held != nullptr ? Py_BuildValue("(ON)", normals, held) : nullptr;
     return s->keep != nullptr ? 0 : -1;
 }
 

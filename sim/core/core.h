@@ -12,7 +12,6 @@
 namespace core {
 
 constexpr int64_t NS = 1000000000;
-constexpr const char *NODE = "FGPropertyNode";
 
 // What Stepper.run returns.
 enum : int { DONE = 0, TARGET = 1, JUDGE = 2 };
@@ -28,14 +27,16 @@ struct Jsb {
     set_fn set;
     const void *vt_fdm;   // where an FGFDMExec's vtable pointer points
     const void *vt_node;  // where an SGPropertyNode's vtable pointer points
+    const void *base;     // where the library is loaded
 };
 
 // The functions of the jsbsim wheel's library `lib_path` (already loaded by the jsbsim module).
 bool jsb_resolve(const char *lib_path, Jsb *j);
 
-// The C++ object a jsbsim Python object of class `cls` (FGFDMExec, FGPropertyNode) wraps, its
+// The JSBSim object a jsbsim FGFDMExec or FGPropertyNode Python object wraps, its class and
 // vtable checked; nullptr with a TypeError set if it is not one.
-void *jsb_wrapped(PyObject *o, const char *cls, const void *vt);
+void *jsb_fdm(const Jsb &j, PyObject *o);
+void *jsb_node(const Jsb &j, PyObject *o);
 
 // n doubles from a sequence of exactly n numbers; false with an exception set otherwise.
 bool seq_doubles(PyObject *seq, double *out, Py_ssize_t n, const char *what);

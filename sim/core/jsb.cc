@@ -10,17 +10,23 @@
 
 namespace core {
 
-// The C++ object a jsbsim Python object of class `cls` wraps: the first of its fields
-// (the words after the object header, within the class's size) that points at an object
-// whose vtable is `vt`. Only objects of that class are looked into: their fields are
-// pointers or null, never a value that cannot be dereferenced.
-void *jsb_wrapped(PyObject *o, const char *cls, const void *vt)
+namespace {
+
+// The C++ object a jsbsim Python object of class `cls` wraps: the first of its fields (the
+// words after the object header, within the class's size) that points at an object whose
+// vtable is `vt`. Only objects of that class of the jsbsim library itself (its type's
+// functions are the library's) are looked into: their fields are pointers or null.
+void *wrapped(const Jsb &j, PyObject *o, const char *cls, const void *vt)
 {
-    const char *name = Py_TYPE(o)->tp_name;
+    PyTypeObject *type = Py_TYPE(o);
+    const char *name = type->tp_name;
     const char *dot = strrchr(name, '.');
-    if (strcmp(dot != nullptr ? dot + 1 : name, cls) == 0) {
+    Dl_info info;
+    if (strcmp(dot != nullptr ? dot + 1 : name, cls) == 0 &&
+        dladdr(reinterpret_cast<void *>(type->tp_dealloc), &info) != 0 &&
+        info.dli_fbase == j.base) {
         void **words = reinterpret_cast<void **>(o);
-        size_t size = static_cast<size_t>(Py_TYPE(o)->tp_basicsize) / sizeof(void *);
+        size_t size = static_cast<size_t>(type->tp_basicsize) / sizeof(void *);
         for (size_t i = 2; i < size; i++) {
             void *p = words[i];
             if (p != nullptr && (reinterpret_cast<uintptr_t>(p) & 7) == 0 &&
@@ -30,6 +36,18 @@ void *jsb_wrapped(PyObject *o, const char *cls, const void *vt)
     }
     PyErr_Format(PyExc_TypeError, "%s is not a jsbsim %s wrapping a JSBSim object", name, cls);
     return nullptr;
+}
+
+}  // namespace
+
+void *jsb_fdm(const Jsb &j, PyObject *o)
+{
+    return wrapped(j, o, "FGFDMExec", j.vt_fdm);
+}
+
+void *jsb_node(const Jsb &j, PyObject *o)
+{
+    return wrapped(j, o, "FGPropertyNode", j.vt_node);
 }
 
 bool jsb_resolve(const char *lib_path, Jsb *j)
@@ -50,6 +68,12 @@ bool jsb_resolve(const char *lib_path, Jsb *j)
                      lib_path);
         return false;
     }
+    Dl_info info;
+    if (dladdr(run, &info) == 0) {
+        PyErr_Format(PyExc_ImportError, "cannot tell where %s is loaded", lib_path);
+        return false;
+    }
+    j->base = info.dli_fbase;
     j->run = reinterpret_cast<run_fn>(run);
     j->get = reinterpret_cast<get_fn>(get);
     j->set = reinterpret_cast<set_fn>(set);

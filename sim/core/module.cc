@@ -3,6 +3,7 @@
 // sim/imaworld/core.py from the build tree.
 
 #include "core.h"
+#include "core_digest.h"
 
 namespace {
 
@@ -55,7 +56,8 @@ PyMODINIT_FUNC PyInit__core(void)
         !add_type(m, &core::ahrs_spec) || !add_type(m, &core::truth_spec) ||
         !add_type(m, &core::adc_spec) || PyModule_AddIntConstant(m, "DONE", core::DONE) < 0 ||
         PyModule_AddIntConstant(m, "TARGET", core::TARGET) < 0 ||
-        PyModule_AddIntConstant(m, "JUDGE", core::JUDGE) < 0) {
+        PyModule_AddIntConstant(m, "JUDGE", core::JUDGE) < 0 ||
+        PyModule_AddStringConstant(m, "SOURCE", CORE_SOURCE_DIGEST) < 0) {
         Py_DECREF(m);
         return nullptr;
     }

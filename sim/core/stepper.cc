@@ -54,7 +54,7 @@ int stepper_init(PyObject *self_, PyObject *args, PyObject *kw)
     }
     if (!jsb_resolve(lib, &s->jsb))
         return -1;
-    s->fdm = jsb_wrapped(fdm, "FGFDMExec", s->jsb.vt_fdm);
+    s->fdm = jsb_fdm(s->jsb, fdm);
     if (s->fdm == nullptr)
         return -1;
     PyObject *fast = PySequence_Fast(ctl, "controls");
@@ -66,23 +66,25 @@ int stepper_init(PyObject *self_, PyObject *args, PyObject *kw)
         return -1;
     }
     for (int i = 0; i < 4; i++) {
-        s->ctl[i] = jsb_wrapped(PySequence_Fast_GET_ITEM(fast, i), NODE, s->jsb.vt_node);
+        s->ctl[i] = jsb_node(s->jsb, PySequence_Fast_GET_ITEM(fast, i));
         if (s->ctl[i] == nullptr) {
             Py_DECREF(fast);
             return -1;
         }
     }
     Py_DECREF(fast);
-    const void *vt = s->jsb.vt_node;
-    if (!(s->agl = jsb_wrapped(agl, NODE, vt)) || !(s->phi = jsb_wrapped(phi, NODE, vt)) ||
-        !(s->cas = jsb_wrapped(cas, NODE, vt)) || !(s->nz = jsb_wrapped(nz, NODE, vt)))
+    const Jsb &j = s->jsb;
+    if (!(s->agl = jsb_node(j, agl)) || !(s->phi = jsb_node(j, phi)) ||
+        !(s->cas = jsb_node(j, cas)) || !(s->nz = jsb_node(j, nz)))
         return -1;
     if (!seq_doubles(lo, s->lo, 4, "lo") || !seq_doubles(hi, s->hi, 4, "hi") ||
         !seq_doubles(moves, s->move, 4, "moves"))
         return -1;
     s->hz = hz;
     s->n = 0;
-    Py_XSETREF(s->keep, Py_BuildValue("(OOOOOO)", fdm, ctl, agl, phi, cas, nz));
+    PyObject *held = PySequence_Tuple(ctl);  // a copy: the nodes stay what was given
+    Py_XSETREF(s->keep, held != nullptr ? Py_BuildValue("(ONOOOO)", fdm, held, agl, phi, cas, nz)
+                                        : nullptr);
     return s->keep != nullptr ? 0 : -1;
 }
 
@@ -200,7 +202,7 @@ PyObject *stepper_get(PyObject *self_, PyObject *node)
         PyErr_SetString(PyExc_RuntimeError, "the Stepper was not set up");
         return nullptr;
     }
-    void *p = jsb_wrapped(node, NODE, s->jsb.vt_node);
+    void *p = jsb_node(s->jsb, node);
     if (p == nullptr)
         return nullptr;
     return PyFloat_FromDouble(s->jsb.get(p));

@@ -24,6 +24,10 @@ struct Truth {
     PyObject *keep;
 };
 
+// The longest string written here (the modes and states are short words); with it the
+// longest line (19 keys, 18 numbers of up to 24 characters, 4 strings) fits in Line::buf.
+constexpr Py_ssize_t MAX_STR = 32;
+
 struct Line {
     char buf[1024];
     size_t n = 0;
@@ -55,7 +59,7 @@ struct Line {
         }
         Py_ssize_t k;
         const char *u = PyUnicode_Check(s) ? PyUnicode_AsUTF8AndSize(s, &k) : nullptr;
-        if (u == nullptr || k > 200) {
+        if (u == nullptr || k > MAX_STR) {
             PyErr_Clear();
             return false;
         }
@@ -159,7 +163,7 @@ int truth_init(PyObject *self_, PyObject *args, PyObject *kw)
         return -1;
     bool ok = PySequence_Fast_GET_SIZE(fn) == NN;
     for (int k = 0; ok && k < NN; k++)
-        ok = (s->node[k] = jsb_wrapped(PySequence_Fast_GET_ITEM(fn, k), NODE, s->jsb.vt_node));
+        ok = (s->node[k] = jsb_node(s->jsb, PySequence_Fast_GET_ITEM(fn, k)));
     Py_DECREF(fn);
     if (!ok) {
         if (!PyErr_Occurred())
@@ -168,7 +172,8 @@ int truth_init(PyObject *self_, PyObject *args, PyObject *kw)
     }
     s->hypot = hypot;
     s->atan2 = atan2;
-    s->keep = Py_BuildValue("(OOO)", nodes, hypot, atan2);
+    PyObject *held = PySequence_Tuple(nodes);  // a copy: the nodes stay what was given
+    s->keep = held != nullptr ? Py_BuildValue("(NOO)", held, hypot, atan2) : nullptr;
     return s->keep != nullptr ? 0 : -1;
 }
 

@@ -65,8 +65,8 @@ def build_parser() -> argparse.ArgumentParser:
                     "channel out (to show that a campaign oracle can fail); every-quantum makes "
                     "the world ask for every quantum of the bus, not only those a task of it "
                     "falls in (to show that the quanta it skips change nothing); python-only "
-                    "makes it run its Python where it has C++, the physics steps and the AHRS "
-                    "(to show that the C++ changes nothing)")
+                    "makes it run its Python where it has C++: the physics steps, the AHRS, the "
+                    "air data and the truth (to show that the C++ changes nothing)")
     ap.add_argument("--uplink", action="append", default=[], metavar="T:FILE",
                     help="uplink the mission plan image FILE (`ima mission` compiles one) over "
                     "the C2 link at T seconds; repeatable (a later plan replaces the earlier)")

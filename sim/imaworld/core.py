@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The world's C++ (sim/core/*.cc, the module imaworld._core in the build tree): its physics
-steps (stepper.py) and its sensors' samples (sensors.py).
+steps (stepper.py), the AHRS's and air data computer's samples (sensors.py) and the truth
+record (world.py).
 
 It computes what the Python computes, to the bit, on the same objects: the aircraft's own
 JSBSim (through the functions the `jsbsim` wheel's library exports) and the same noise streams.
@@ -17,6 +18,9 @@ import sys
 from pathlib import Path
 
 DONE, TARGET, JUDGE = 0, 1, 2  # what Stepper.run returns
+# What the module's constructors raise when they cannot work on what they are given (another
+# JSBSim, say): the world then runs its Python.
+REFUSALS = (TypeError, ValueError, ImportError, AttributeError)
 
 _module = None
 _why_not: str | None = None
@@ -44,16 +48,39 @@ def load():
     except ImportError as e:
         _why_not = f"cannot load {path}: {e}"
         return None
-    if (mod.DONE, mod.TARGET, mod.JUDGE) != (DONE, TARGET, JUDGE):
-        _why_not = f"{path} was not built from this source"
+    if getattr(mod, "SOURCE", None) != source_digest():
+        _why_not = f"{path} was not built from this source (./ima builds it)"
         return None
     _module = mod
     return mod
 
 
 def jsbsim_library(fdm) -> str:
-    """The file of the jsbsim wheel's library that this FGFDMExec comes from."""
-    return sys.modules[type(fdm).__module__].__file__
+    """The file of the jsbsim wheel's library that this FGFDMExec comes from (ImportError if
+    it cannot be told)."""
+    import jsbsim
+
+    for mod in (sys.modules.get(type(fdm).__module__), getattr(jsbsim, "_jsbsim", None)):
+        path = getattr(mod, "__file__", None)
+        if path:
+            return path
+    raise ImportError("cannot tell which file JSBSim's library was loaded from")
+
+
+def source_digest() -> str | None:
+    """The digest of sim/core's sources, as the build compiles it into the module (SOURCE;
+    sim/CMakeLists.txt): a module built from other sources is not used. None if the sources
+    are not beside this package."""
+    import hashlib
+
+    src = Path(__file__).resolve().parents[1] / "core"
+    files = sorted(p for p in src.glob("*") if p.suffix in (".cc", ".h"))
+    if not files:
+        return None
+    h = hashlib.sha256()
+    for p in files:
+        h.update(p.name.encode() + b"\0" + p.read_bytes() + b"\0")
+    return h.hexdigest()[:16]
 
 
 def why_not() -> str | None:

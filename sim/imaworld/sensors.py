@@ -192,6 +192,8 @@ class Ahrs:
                 self._last_in_core = True
                 return out
             return self._emit(core.last())  # a value not finite: encoding it raises, as ever
+        if self._last_in_core:  # the values of the last frames sent, before the next draw
+            self.last_vals = core.last()
         return self._emit(core.vals())
 
     def sample(self, phi: float, theta: float, psi: float, p_: float, q: float, r: float,

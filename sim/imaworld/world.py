@@ -75,7 +75,7 @@ class Options:
     # channel out, to show that a campaign oracle can fail; "every-quantum" makes the world
     # ask for every quantum (see World._delivered), to show that skipping them changes nothing;
     # "python-only" makes it run its Python where it has C++ (core.py: the physics steps, the
-    # AHRS), to show that the C++ changes nothing.
+    # AHRS, the air data, the truth), to show that the C++ changes nothing.
     test_switches: tuple[str, ...] = ()
     # Mission plan images the station uplinks (--uplink T:FILE): [(t_ns, image)]
     uploads: list[tuple[int, bytes]] = field(default_factory=list)
@@ -323,25 +323,20 @@ class World(Physics):
     def _attach_sensors(self) -> None:
         """What samples and records in C++: the AHRS, the air data, and the truth without
         traffic (the same draws, frames and lines)."""
-        node, lib = self.ac.node, core.jsbsim_library(self.ac.fdm)
+        node, mod = self.ac.node, self._core
         try:
-            self.ahrs.attach(self._core, lib, [node[k] for k in ("phi", "theta", "psi", "p", "q",
-                                                                 "r", "ax", "ay", "az")])
-        except (TypeError, ValueError, ImportError) as e:
-            core.unavailable("sampling the AHRS", str(e))
-        try:
-            self.adc.attach(self._core, lib, [node[k] for k in ("cas", "palt", "hdot")])
-        except (TypeError, ValueError, ImportError) as e:
-            core.unavailable("sampling the air data", str(e))
-        if self.traffic is not None:
-            return
-        try:
-            self._truth_core = self._core.Truth(
-                lib, [node[k] for k in ("lat", "lon", "alt", "agl", "cas", "tas", "vn", "ve",
-                                        "psi", "phi", "theta", "hdot", "wind_n", "wind_e")],
-                math.hypot, math.atan2)
-        except (TypeError, ValueError, ImportError) as e:
-            core.unavailable("writing the truth", str(e))
+            lib = core.jsbsim_library(self.ac.fdm)
+            self.ahrs.attach(mod, lib, [node[k] for k in ("phi", "theta", "psi", "p", "q", "r",
+                                                          "ax", "ay", "az")])
+            self.adc.attach(mod, lib, [node[k] for k in ("cas", "palt", "hdot")])
+            if self.traffic is None:
+                self._truth_core = mod.Truth(
+                    lib, [node[k] for k in ("lat", "lon", "alt", "agl", "cas", "tas", "vn", "ve",
+                                            "psi", "phi", "theta", "hdot", "wind_n", "wind_e")],
+                    math.hypot, math.atan2)
+        except core.REFUSALS as e:
+            self.ahrs.core = self.adc.core = self._truth_core = None
+            core.unavailable("sampling and recording", str(e))
 
     def _gps(self, t: int) -> None:
         g = self.ac.get

@@ -2,11 +2,13 @@
 """Same seed, same inputs: the lockstep makes two flights byte-identical, world truth, CAN bus
 trace and node trace alike; another seed flies differently. The quanta the world skips (it asks
 for those its tasks fall in) change nothing: a world granted every quantum flies the same; nor
-do the windows an SKE runs ahead of the bus (its partitions that are not system partitions)."""
+do the windows an SKE runs ahead of the bus (its partitions that are not system partitions);
+nor does the world's C++ (imaworld.core): its Python flies the same, a landing too."""
 
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 from flight_helpers import fault
@@ -31,6 +33,12 @@ def every_quantum(flights):
 def ske_every_quantum(flights):
     return flights.fly("det_ske_every_quantum", seed=11, duration_s=60.0, turbulence="light",
                        wind_kt=10, test_switches=["ske:every-quantum"])
+
+
+@pytest.fixture(scope="module")
+def python_only(flights):
+    return flights.fly("det_python_only", seed=11, duration_s=60.0, turbulence="light",
+                       wind_kt=10, test_switches=["world:python-only"])
 
 
 def _ticks(run, client: str) -> dict:
@@ -75,6 +83,24 @@ def test_windows_run_ahead_change_nothing(runs, ske_every_quantum, name):
     # woken for its io windows only (2 quanta of 5), not for every window (3 of 5)
     assert ahead["ticks"] + ahead["ticks_skipped"] == every["ticks"] + every["ticks_skipped"]
     assert ahead["ticks"] < every["ticks"], (ahead, every)
+
+
+@pytest.mark.parametrize("name", FILES)
+def test_the_worlds_cplusplus_changes_nothing(runs, python_only, name):
+    assert (runs[0].run_dir / name).read_bytes() == (python_only.run_dir / name).read_bytes()
+
+
+def test_a_landing_with_the_worlds_cplusplus_or_its_python(flights):
+    """The ground: the wheels, the brakes and the roll-out, judged in Python either way."""
+    data = Path(__file__).resolve().parents[1] / "mission" / "data"
+    kw = dict(mission=data / "approach.yaml", pilot=data / "approach_pilot.yaml",
+              duration_s=430.0, seed=1, turbulence="none")
+    a = flights.fly("det_land", **kw)
+    b = flights.fly("det_land_python_only", test_switches=["world:python-only"], **kw)
+    landing = json.loads((a.run_dir / "world.json").read_text())["landing"]
+    assert landing["stopped"], landing
+    for name in FILES:
+        assert (a.run_dir / name).read_bytes() == (b.run_dir / name).read_bytes(), name
 
 
 def test_a_crash_stops_the_run_in_its_quantum_either_way(flights):

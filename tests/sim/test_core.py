@@ -58,6 +58,35 @@ def test_commands_that_stop_hold_then_go_safe(local_world):
     assert states == ["NORMAL", "HOLD_LAST", "SAFE"]
 
 
+def test_no_command_at_all_holds_the_trim_then_goes_safe(local_world):
+    c, p = both(local_world, "hold.yaml", 4)
+    assert_same(c, p)
+    states = [e["state"] for e in c.events() if e["kind"] == "actuator_state"]
+    assert states == ["SAFE"], states
+
+
+def test_simplex_fails_over_to_the_next_channel(local_world):
+    def channel_cmd(ch, t, trim):
+        if ch == 0 and t >= 1 * NS:
+            return None  # A falls silent at 1 s, B goes on
+        return (trim[0] + 0.01 * ch,) + trim[1:] if ch < 2 else None
+
+    c, p = both(local_world, "hold.yaml", 3, channel_cmd=channel_cmd)
+    assert_same(c, p)
+    got = [(e["state"], e["channel"]) for e in c.events() if e["kind"] == "actuator_state"]
+    assert got == [("NORMAL", "A"), ("NORMAL", "B")], got
+
+
+def test_voted_channels_that_all_stop_hold_then_latch_safe(local_world):
+    def channel_cmd(ch, t, trim):
+        return None if t >= 1 * NS else trim
+
+    c, p = both(local_world, "hold.yaml", 3, channel_cmd=channel_cmd, channels=3)
+    assert_same(c, p)
+    states = [e["state"] for e in c.events() if e["kind"] == "actuator_state"]
+    assert states[-2:] == ["HOLD_LAST", "SAFE"], states
+
+
 def test_voted_channels_one_voted_out(local_world):
     def channel_cmd(ch, t, trim):
         if ch == 2 and t >= 1 * NS:
@@ -74,6 +103,7 @@ def test_actuator_faults_step_in_python_and_back(local_world):
              parse("actuator_hardover:fid=h,at=2s,until=2.5s,surface=ail,value=0.5")]
     c, p = both(local_world, "hold.yaml", 3, cmd="trim", faults=specs)
     assert_same(c, p)
+    assert c.world.act.until > 0  # the C++ stepped again after the last spell
 
 
 def test_sensor_faults_with_the_cplusplus_samples(local_world):
@@ -82,6 +112,13 @@ def test_sensor_faults_with_the_cplusplus_samples(local_world):
              parse("ahrs_bias:fid=b,at=1.2s,until=2.5s,axis=roll,value=5"),
              parse("pitot_blocked:fid=p,at=1s,until=2s")]
     c, p = both(local_world, "hold.yaml", 3, cmd="trim", faults=specs, seed=5)
+    assert_same(c, p)
+    # a stuck AHRS whose spells fall between samples, and two stuck ones at once: each holds
+    # the values of the last frames sent
+    specs = [parse("ahrs_stuck:fid=s,at=1s,period=30ms,on=25ms,counter=frozen"),
+             parse("ahrs_stuck:fid=t,at=2.01s,until=2.2s"),
+             parse("ahrs_stuck:fid=u,at=2.1s,until=2.3s")]
+    c, p = both(local_world, "hold.yaml", 2.5, cmd="trim", faults=specs, seed=5)
     assert_same(c, p)
 
 
@@ -136,6 +173,28 @@ def test_numbers_are_rounded_and_written_as_the_python_does():
     for x in xs:
         for n in (1, 2, 3, 4, 7):
             assert number(x, n) == json.dumps(_r(x, n)), (x, n)
+
+
+def test_a_module_that_refuses_leaves_the_world_to_its_python(local_world, monkeypatch,
+                                                                capsys):
+    import types
+
+    real = core.load()
+
+    def refuse(*a):
+        raise TypeError("refused")
+
+    broken = types.SimpleNamespace(Normals=real.Normals, Stepper=refuse, Ahrs=refuse, Adc=refuse,
+                                   Truth=refuse)
+    p = local_world("hold.yaml", 2, cmd="trim", test_switches=("python-only",))
+    monkeypatch.setattr(core, "load", lambda: broken)
+    monkeypatch.setattr(core, "_told", set())
+    c = local_world("hold.yaml", 2, cmd="trim")
+    assert c.world._stepper is None and c.world.ahrs.core is None
+    assert "in Python (" in capsys.readouterr().err
+    for name in ("truth.jsonl", "world.jsonl"):
+        assert (c.run_dir / name).read_bytes() == (p.run_dir / name).read_bytes(), name
+    assert c.bus.sent == p.bus.sent
 
 
 def test_a_stepper_refuses_what_is_not_jsbsim(local_world):

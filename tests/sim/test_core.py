@@ -212,3 +212,35 @@ def test_a_stepper_refuses_what_is_not_jsbsim(local_world):
         mod.Stepper("/nonexistent/_jsbsim.so", *args[1:])
     with pytest.raises(RuntimeError):
         mod.Stepper.__new__(mod.Stepper).run(1, 0, [0.0] * 4, (0.0,) * 4, 0, False)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_target_holds_until_the_instant_targeted_names(seed):
+    """Actuators.targeted: at every instant before `until`, _target() gives the same target and
+    records nothing (checked on a copy, instant by instant, over random command streams with
+    failovers, gaps, hold-last and safe)."""
+    import copy
+    import random
+
+    from imaworld.actuators import Actuators
+    from imaworld.config import DEFAULT
+
+    rnd = random.Random(seed)
+    act = Actuators(DEFAULT.actuators, (0.0, 0.0, 0.0, 0.6))
+    step = 1_000_000  # 1 ms
+    t = 0
+    while t < 3 * NS:
+        if rnd.random() < 0.02:  # a command on a channel that is not silent now
+            ch = rnd.choice((0, 0, 1, 2))
+            if not (1 * NS <= t < 1.3 * NS and ch == 0) and not 2 * NS <= t < 2.8 * NS:
+                act.command(ch, t, (rnd.uniform(-0.1, 0.1), 0.0, 0.0, 0.6))
+        act.targeted(t)
+        until = act.until
+        assert until > t
+        probe = copy.deepcopy(act)
+        last = [until - 1] if until < t + 400 * step else []  # the last instant it holds
+        for u in [*range(t + step, min(until, t + 400 * step), step), *last]:
+            n = len(probe.transitions)
+            assert probe._target(u) == act.target, (t, u, until)
+            assert len(probe.transitions) == n, (t, u, until)
+        t += rnd.choice((step, 7 * step))

@@ -16,22 +16,12 @@ struct Adc {
     Jsb jsb;
     void *node[NN];
     Normals *n;
-    double a[2], q[2], x[2];  // Gauss-Markov biases: airspeed, altitude
+    Biases bias;  // airspeed, altitude
     double noise_ias, noise_alt, noise_vs;
     Msg msg;  // AIR_DATA
     double last[3];
     PyObject *keep;
 };
-
-bool bias(Adc *s, int k, double *out)
-{
-    double d;
-    if (!normals_next(s->n, &d))
-        return false;
-    s->x[k] = s->a[k] * s->x[k] + s->q[k] * d;
-    *out = s->x[k];
-    return true;
-}
 
 // frames(counter, cas) -> [(id, data)] of the next sample (cas None: the aircraft's), or None
 // if a value is not finite (drawn all the same; last() has them)
@@ -52,11 +42,11 @@ PyObject *adc_frames(PyObject *self_, PyObject *const *args, Py_ssize_t nargs)
         return nullptr;
     double palt = s->jsb.get(s->node[PALT]), hdot = s->jsb.get(s->node[HDOT]);
     double b, d;
-    if (!bias(s, 0, &b) || !normals_next(s->n, &d))
+    if (!biases_step(&s->bias, 0, s->n, &b) || !normals_next(s->n, &d))
         return nullptr;
     double ias = cas + b + s->noise_ias * d;
     s->last[0] = ias > 0.0 ? ias : 0.0;  // max(0.0, ias)
-    if (!bias(s, 1, &b) || !normals_next(s->n, &d))
+    if (!biases_step(&s->bias, 1, s->n, &b) || !normals_next(s->n, &d))
         return nullptr;
     s->last[1] = palt + b + s->noise_alt * d;
     if (!normals_next(s->n, &d))
@@ -95,37 +85,8 @@ int adc_init(PyObject *self_, PyObject *args, PyObject *kw)
         PyErr_SetString(PyExc_TypeError, "normals: an imaworld._core.Normals expected");
         return -1;
     }
-    PyObject *fn = PySequence_Fast(nodes, "nodes");
-    if (fn == nullptr)
+    if (!jsb_nodes(s->jsb, nodes, s->node, NN) || !biases_parse(biases, &s->bias, 2))
         return -1;
-    bool ok = PySequence_Fast_GET_SIZE(fn) == NN;
-    for (int k = 0; ok && k < NN; k++)
-        ok = (s->node[k] = jsb_node(s->jsb, PySequence_Fast_GET_ITEM(fn, k)));
-    Py_DECREF(fn);
-    if (!ok) {
-        if (!PyErr_Occurred())
-            PyErr_SetString(PyExc_ValueError, "nodes: 3 property nodes expected");
-        return -1;
-    }
-    PyObject *fb = PySequence_Fast(biases, "biases");
-    if (fb == nullptr)
-        return -1;
-    ok = PySequence_Fast_GET_SIZE(fb) == 2;
-    for (int k = 0; ok && k < 2; k++) {
-        double aqx[3];
-        ok = seq_doubles(PySequence_Fast_GET_ITEM(fb, k), aqx, 3, "a bias (a, q, x)");
-        if (ok) {
-            s->a[k] = aqx[0];
-            s->q[k] = aqx[1];
-            s->x[k] = aqx[2];
-        }
-    }
-    Py_DECREF(fb);
-    if (!ok) {
-        if (!PyErr_Occurred())
-            PyErr_SetString(PyExc_ValueError, "biases: 2 (a, q, x) expected");
-        return -1;
-    }
     double nz[3];
     if (!seq_doubles(noise, nz, 3, "noise (ias, alt, vs)") || !msg_parse(msg, &s->msg))
         return -1;
@@ -144,10 +105,7 @@ int adc_init(PyObject *self_, PyObject *args, PyObject *kw)
 
 void adc_dealloc(PyObject *self_)
 {
-    PyTypeObject *type = Py_TYPE(self_);
-    Py_XDECREF(reinterpret_cast<Adc *>(self_)->keep);
-    type->tp_free(self_);
-    Py_DECREF(type);
+    dealloc_keeping(self_, reinterpret_cast<Adc *>(self_)->keep);
 }
 
 PyMethodDef adc_methods[] = {

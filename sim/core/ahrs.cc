@@ -21,23 +21,13 @@ struct Ahrs {
     Jsb jsb;
     void *node[NV];  // phi, theta, psi (deg), p, q, r (rad/s), ax, ay, az (g)
     Normals *n;
-    double a[NV], q[NV], x[NV];
+    Biases bias;  // roll, pitch, heading, p, q, r, ax, ay, az
     double noise_att, noise_hdg, noise_rate, noise_accel;
     Msg msg[3];  // AHRS_ATT, AHRS_RATE, AHRS_ACCEL
     double last[NV];
     bool has_last;
     PyObject *keep;  // (normals, nodes): what the pointers above point into
 };
-
-bool bias(Ahrs *s, int k, double *out)
-{
-    double d;
-    if (!normals_next(s->n, &d))
-        return false;
-    s->x[k] = s->a[k] * s->x[k] + s->q[k] * d;
-    *out = s->x[k];
-    return true;
-}
 
 // One sample's values, as sensors.Ahrs.sample computes them, into s->last.
 bool draw(Ahrs *s)
@@ -46,7 +36,7 @@ bool draw(Ahrs *s)
     for (int k = 0; k < NV; k++)
         in[k] = s->jsb.get(s->node[k]);
     double *v = s->last;
-    if (!bias(s, 0, &b) || !normals_next(s->n, &d))
+    if (!biases_step(&s->bias, 0, s->n, &b) || !normals_next(s->n, &d))
         return false;
     double roll = in[0] + b + s->noise_att * d;
     if (roll > 180.0)
@@ -54,20 +44,20 @@ bool draw(Ahrs *s)
     else if (roll < -180.0)
         roll += 360.0;
     v[0] = roll;
-    if (!bias(s, 1, &b) || !normals_next(s->n, &d))
+    if (!biases_step(&s->bias, 1, s->n, &b) || !normals_next(s->n, &d))
         return false;
     v[1] = in[1] + b + s->noise_att * d;
-    if (!bias(s, 2, &b) || !normals_next(s->n, &d))
+    if (!biases_step(&s->bias, 2, s->n, &b) || !normals_next(s->n, &d))
         return false;
     double hdg = py_mod(in[2] + b + s->noise_hdg * d, 360.0);
     v[2] = hdg >= 359.995 ? 0.0 : hdg;
     for (int k = 3; k < 6; k++) {
-        if (!bias(s, k, &b) || !normals_next(s->n, &d))
+        if (!biases_step(&s->bias, k, s->n, &b) || !normals_next(s->n, &d))
             return false;
         v[k] = in[k] * DEG + b + s->noise_rate * d;
     }
     for (int k = 6; k < 9; k++) {
-        if (!bias(s, k, &b) || !normals_next(s->n, &d))
+        if (!biases_step(&s->bias, k, s->n, &b) || !normals_next(s->n, &d))
             return false;
         v[k] = in[k] + b + s->noise_accel * d;
     }
@@ -156,37 +146,8 @@ int ahrs_init(PyObject *self_, PyObject *args, PyObject *kw)
         PyErr_SetString(PyExc_TypeError, "normals: an imaworld._core.Normals expected");
         return -1;
     }
-    PyObject *fn = PySequence_Fast(nodes, "nodes");
-    if (fn == nullptr)
+    if (!jsb_nodes(s->jsb, nodes, s->node, NV) || !biases_parse(biases, &s->bias, NV))
         return -1;
-    bool ok = PySequence_Fast_GET_SIZE(fn) == NV;
-    for (int k = 0; ok && k < NV; k++)
-        ok = (s->node[k] = jsb_node(s->jsb, PySequence_Fast_GET_ITEM(fn, k)));
-    Py_DECREF(fn);
-    if (!ok) {
-        if (!PyErr_Occurred())
-            PyErr_SetString(PyExc_ValueError, "nodes: 9 property nodes expected");
-        return -1;
-    }
-    PyObject *fb = PySequence_Fast(biases, "biases");
-    if (fb == nullptr)
-        return -1;
-    ok = PySequence_Fast_GET_SIZE(fb) == NV;
-    for (int k = 0; ok && k < NV; k++) {
-        double aqx[3];
-        ok = seq_doubles(PySequence_Fast_GET_ITEM(fb, k), aqx, 3, "a bias (a, q, x)");
-        if (ok) {
-            s->a[k] = aqx[0];
-            s->q[k] = aqx[1];
-            s->x[k] = aqx[2];
-        }
-    }
-    Py_DECREF(fb);
-    if (!ok) {
-        if (!PyErr_Occurred())
-            PyErr_SetString(PyExc_ValueError, "biases: 9 (a, q, x) expected");
-        return -1;
-    }
     double nz[4];
     if (!seq_doubles(noise, nz, 4, "noise (att, hdg, rate, accel)"))
         return -1;
@@ -197,7 +158,7 @@ int ahrs_init(PyObject *self_, PyObject *args, PyObject *kw)
     PyObject *fm = PySequence_Fast(msgs, "messages");
     if (fm == nullptr)
         return -1;
-    ok = PySequence_Fast_GET_SIZE(fm) == 3;
+    bool ok = PySequence_Fast_GET_SIZE(fm) == 3;
     for (int m = 0; ok && m < 3; m++)
         ok = msg_parse(PySequence_Fast_GET_ITEM(fm, m), &s->msg[m]) && s->msg[m].nsig == 5;
     Py_DECREF(fm);
@@ -215,10 +176,7 @@ int ahrs_init(PyObject *self_, PyObject *args, PyObject *kw)
 
 void ahrs_dealloc(PyObject *self_)
 {
-    PyTypeObject *type = Py_TYPE(self_);
-    Py_XDECREF(reinterpret_cast<Ahrs *>(self_)->keep);
-    type->tp_free(self_);
-    Py_DECREF(type);
+    dealloc_keeping(self_, reinterpret_cast<Ahrs *>(self_)->keep);
 }
 
 PyMethodDef ahrs_methods[] = {

@@ -37,6 +37,8 @@ bool jsb_resolve(const char *lib_path, Jsb *j);
 // vtable checked; nullptr with a TypeError set if it is not one.
 void *jsb_fdm(const Jsb &j, PyObject *o);
 void *jsb_node(const Jsb &j, PyObject *o);
+// The JSBSim property nodes of a sequence of exactly n of them; false with an exception set.
+bool jsb_nodes(const Jsb &j, PyObject *seq, void **out, Py_ssize_t n);
 
 // n doubles from a sequence of exactly n numbers; false with an exception set otherwise.
 bool seq_doubles(PyObject *seq, double *out, Py_ssize_t n, const char *what);
@@ -54,6 +56,20 @@ bool is_normals(PyObject *o);
 
 // The next draw; false with an exception set if a new block cannot be had.
 bool normals_next(Normals *s, double *x);
+
+// A sensor's first-order Gauss-Markov biases (sensors.GaussMarkov): x = a x + q n().
+constexpr int MAX_BIASES = 9;
+struct Biases {
+    double a[MAX_BIASES], q[MAX_BIASES], x[MAX_BIASES];
+};
+// Exactly n of them from ((a, q, x), ...); false with an exception set.
+bool biases_parse(PyObject *seq, Biases *b, int n);
+// Bias k's next value, drawn from n.
+bool biases_step(Biases *b, int k, Normals *n, double *out);
+
+// What a type of the module does when an object of it goes: `keep` released, the object
+// freed, its heap type released.
+void dealloc_keeping(PyObject *self, PyObject *keep);
 
 // One CAN message as ima.canbus.codec encodes it (codec.cc).
 constexpr int MSG_MAX_SIGNALS = 16;

@@ -50,6 +50,20 @@ void *jsb_node(const Jsb &j, PyObject *o)
     return wrapped(j, o, "FGPropertyNode", j.vt_node);
 }
 
+bool jsb_nodes(const Jsb &j, PyObject *seq, void **out, Py_ssize_t n)
+{
+    PyObject *fast = PySequence_Fast(seq, "nodes");
+    if (fast == nullptr)
+        return false;
+    bool ok = PySequence_Fast_GET_SIZE(fast) == n;
+    for (Py_ssize_t k = 0; ok && k < n; k++)
+        ok = (out[k] = jsb_node(j, PySequence_Fast_GET_ITEM(fast, k))) != nullptr;
+    Py_DECREF(fast);
+    if (!ok && !PyErr_Occurred())
+        PyErr_Format(PyExc_ValueError, "nodes: %zd property nodes expected", n);
+    return ok;
+}
+
 bool jsb_resolve(const char *lib_path, Jsb *j)
 {
     void *h = dlopen(lib_path, RTLD_NOW | RTLD_NOLOAD);

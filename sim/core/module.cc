@@ -5,6 +5,14 @@
 #include "core.h"
 #include "core_digest.h"
 
+void core::dealloc_keeping(PyObject *self, PyObject *keep)
+{
+    PyTypeObject *type = Py_TYPE(self);
+    Py_XDECREF(keep);
+    type->tp_free(self);
+    Py_DECREF(type);  // a heap type: each instance holds a reference
+}
+
 namespace {
 
 

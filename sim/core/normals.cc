@@ -41,11 +41,8 @@ int normals_init(PyObject *self_, PyObject *args, PyObject *kw)
 void normals_dealloc(PyObject *self_)
 {
     Normals *s = reinterpret_cast<Normals *>(self_);
-    PyTypeObject *type = Py_TYPE(self_);
-    Py_XDECREF(s->draw);
     free(s->block);
-    type->tp_free(self_);
-    Py_DECREF(type);
+    dealloc_keeping(self_, s->draw);
 }
 
 PyType_Slot normals_slots[] = {
@@ -101,6 +98,37 @@ bool normals_next(Normals *s, double *x)
         s->i = 0;
     }
     *x = s->block[s->i++];
+    return true;
+}
+
+bool biases_parse(PyObject *seq, Biases *b, int n)
+{
+    PyObject *fast = PySequence_Fast(seq, "biases");
+    if (fast == nullptr)
+        return false;
+    bool ok = n <= MAX_BIASES && PySequence_Fast_GET_SIZE(fast) == n;
+    for (int k = 0; ok && k < n; k++) {
+        double aqx[3];
+        ok = seq_doubles(PySequence_Fast_GET_ITEM(fast, k), aqx, 3, "a bias (a, q, x)");
+        if (ok) {
+            b->a[k] = aqx[0];
+            b->q[k] = aqx[1];
+            b->x[k] = aqx[2];
+        }
+    }
+    Py_DECREF(fast);
+    if (!ok && !PyErr_Occurred())
+        PyErr_Format(PyExc_ValueError, "biases: %d (a, q, x) expected", n);
+    return ok;
+}
+
+bool biases_step(Biases *b, int k, Normals *n, double *out)
+{
+    double d;
+    if (!normals_next(n, &d))
+        return false;
+    b->x[k] = b->a[k] * b->x[k] + b->q[k] * d;
+    *out = b->x[k];
     return true;
 }
 

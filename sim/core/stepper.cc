@@ -57,22 +57,8 @@ int stepper_init(PyObject *self_, PyObject *args, PyObject *kw)
     s->fdm = jsb_fdm(s->jsb, fdm);
     if (s->fdm == nullptr)
         return -1;
-    PyObject *fast = PySequence_Fast(ctl, "controls");
-    if (fast == nullptr)
+    if (!jsb_nodes(s->jsb, ctl, s->ctl, 4))
         return -1;
-    if (PySequence_Fast_GET_SIZE(fast) != 4) {
-        Py_DECREF(fast);
-        PyErr_SetString(PyExc_ValueError, "controls: 4 property nodes expected");
-        return -1;
-    }
-    for (int i = 0; i < 4; i++) {
-        s->ctl[i] = jsb_node(s->jsb, PySequence_Fast_GET_ITEM(fast, i));
-        if (s->ctl[i] == nullptr) {
-            Py_DECREF(fast);
-            return -1;
-        }
-    }
-    Py_DECREF(fast);
     const Jsb &j = s->jsb;
     if (!(s->agl = jsb_node(j, agl)) || !(s->phi = jsb_node(j, phi)) ||
         !(s->cas = jsb_node(j, cas)) || !(s->nz = jsb_node(j, nz)))
@@ -90,10 +76,7 @@ int stepper_init(PyObject *self_, PyObject *args, PyObject *kw)
 
 void stepper_dealloc(PyObject *self_)
 {
-    PyTypeObject *type = Py_TYPE(self_);
-    Py_XDECREF(reinterpret_cast<Stepper *>(self_)->keep);
-    type->tp_free(self_);
-    Py_DECREF(type);  // a heap type: each instance holds a reference
+    dealloc_keeping(self_, reinterpret_cast<Stepper *>(self_)->keep);
 }
 
 // run(t, n, pos, target, until, touchdown) -> DONE | TARGET | JUDGE

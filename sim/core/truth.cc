@@ -158,18 +158,8 @@ int truth_init(PyObject *self_, PyObject *args, PyObject *kw)
     }
     if (!jsb_resolve(lib, &s->jsb))
         return -1;
-    PyObject *fn = PySequence_Fast(nodes, "nodes");
-    if (fn == nullptr)
+    if (!jsb_nodes(s->jsb, nodes, s->node, NN))
         return -1;
-    bool ok = PySequence_Fast_GET_SIZE(fn) == NN;
-    for (int k = 0; ok && k < NN; k++)
-        ok = (s->node[k] = jsb_node(s->jsb, PySequence_Fast_GET_ITEM(fn, k)));
-    Py_DECREF(fn);
-    if (!ok) {
-        if (!PyErr_Occurred())
-            PyErr_SetString(PyExc_ValueError, "nodes: 14 property nodes expected");
-        return -1;
-    }
     s->hypot = hypot;
     s->atan2 = atan2;
     PyObject *held = PySequence_Tuple(nodes);  // a copy: the nodes stay what was given
@@ -179,10 +169,7 @@ int truth_init(PyObject *self_, PyObject *args, PyObject *kw)
 
 void truth_dealloc(PyObject *self_)
 {
-    PyTypeObject *type = Py_TYPE(self_);
-    Py_XDECREF(reinterpret_cast<Truth *>(self_)->keep);
-    type->tp_free(self_);
-    Py_DECREF(type);
+    dealloc_keeping(self_, reinterpret_cast<Truth *>(self_)->keep);
 }
 
 PyMethodDef truth_methods[] = {

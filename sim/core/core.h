@@ -98,6 +98,9 @@ PyObject *msg_frame(const Msg *m, const double *v);
 double py_mod(double x, double y);
 double py_round(double x, int ndigits);
 size_t py_repr(double x, char *out);
+// What json.dumps writes of world._r(x, ndigits) (null when not finite), into out (at most
+// 32 chars), its length returned.
+size_t json_rounded(double x, int ndigits, char *out);
 
 extern PyType_Spec stepper_spec;
 extern PyType_Spec normals_spec;

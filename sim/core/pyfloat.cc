@@ -88,4 +88,16 @@ size_t py_repr(double x, char *out)
     return n;
 }
 
+size_t json_rounded(double x, int ndigits, char *out)
+{
+    if (x != x || std::isinf(x)) {
+        memcpy(out, "null", 4);
+        return 4;
+    }
+    double v = py_round(x, ndigits);
+    if (v == 0.0)
+        v = 0.0;  // no -0.0
+    return py_repr(v, out);
+}
+
 }  // namespace core

@@ -41,14 +41,7 @@ struct Line {
     void num(const char *key, double x, int nd)
     {
         raw(key);
-        if (x != x || std::isinf(x)) {
-            raw("null");
-            return;
-        }
-        double v = py_round(x, nd);
-        if (v == 0.0)
-            v = 0.0;  // no -0.0
-        n += py_repr(v, buf + n);
+        n += json_rounded(x, nd, buf + n);
     }
     bool str(const char *key, PyObject *s)
     {

@@ -89,7 +89,6 @@ def why_not() -> str | None:
 
 def unavailable(what: str, reason: str) -> None:
     """Say once on stderr that the world runs its Python for `what`, and why."""
-    global _told
     if what not in _told:
         _told.add(what)
         print(f"imaworld: {what} in Python ({reason})", file=sys.stderr)

@@ -36,8 +36,9 @@ class Physics:
             n = self.n
             while True:
                 code = st.run(t, n, act.pos, act.target, act.until, ground.touchdown is not None)
-                if st.n != n:
-                    n = self.n = st.n
+                m = st.n
+                if m != n:
+                    n = self.n = m
                     self.next_step_t = (n + 1) * NS // hz
                     self.t_now = n * NS // hz
                 if code == stepper.DONE:

@@ -231,6 +231,10 @@ class World(Physics):
         """The C2 link as it is: the script's state, unless a c2_loss fault has it down."""
         return self.station["c2_link"] == "up" and not (self.faults and self.faults.c2_down)
 
+    def c2_link(self) -> str:
+        """The C2 link as the truth records it."""
+        return "up" if self.link_up() else "down"
+
     def truth(self) -> dict:
         g = self.ac.get
         pos = self.act.pos
@@ -249,7 +253,7 @@ class World(Physics):
             "elev": _r(pos[0], 4), "ail": _r(pos[1], 4), "rud": _r(pos[2], 4),
             "thr": _r(pos[3], 4),
             "fcs_mode": mode, "fcs_fallback": fb,
-            "c2_link": "up" if self.link_up() else "down", "gps": self.gps.effective_state,
+            "c2_link": self.c2_link(), "gps": self.gps.effective_state,
             "wind_n_kt": _r(g["wind_n"]() / 1.6878098571011957, 3),
             "wind_e_kt": _r(g["wind_e"]() / 1.6878098571011957, 3),
             **self._traffic_truth(),
@@ -444,8 +448,8 @@ class World(Physics):
         tc = self._truth_core
         if tc is not None:
             mode, fb = self.fcs_mode()
-            line = tc.line(self.t_now, self.act.pos, mode, fb,
-                           "up" if self.link_up() else "down", self.gps.effective_state)
+            line = tc.line(self.t_now, self.act.pos, mode, fb, self.c2_link(),
+                           self.gps.effective_state)
             if line is not None:
                 self.truth_f.write(line)
                 return

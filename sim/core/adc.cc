@@ -109,7 +109,7 @@ void adc_dealloc(PyObject *self_)
 }
 
 PyMethodDef adc_methods[] = {
-    {"frames", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)(void)>(adc_frames)),
+    {"frames", fastcall(adc_frames),
      METH_FASTCALL, "frames(counter, cas) -> the next sample's frame, or None if not finite"},
     {"last", adc_last, METH_NOARGS, "last() -> the last sample's (ias, alt, vs)"},
     {nullptr, nullptr, 0, nullptr},

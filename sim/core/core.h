@@ -71,6 +71,12 @@ bool biases_step(Biases *b, int k, Normals *n, double *out);
 // freed, its heap type released.
 void dealloc_keeping(PyObject *self, PyObject *keep);
 
+// A METH_FASTCALL function as PyMethodDef holds it (the cast CPython's API asks for).
+inline PyCFunction fastcall(PyObject *(*f)(PyObject *, PyObject *const *, Py_ssize_t))
+{
+    return reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)(void)>(f));
+}
+
 // One CAN message as ima.canbus.codec encodes it (codec.cc).
 constexpr int MSG_MAX_SIGNALS = 16;
 struct Sig {

@@ -197,7 +197,7 @@ PyObject *stepper_n(PyObject *self_, void *)
 }
 
 PyMethodDef stepper_methods[] = {
-    {"run", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)(void)>(stepper_run)),
+    {"run", fastcall(stepper_run),
      METH_FASTCALL, "run(t, n, pos, target, until, touchdown) -> DONE | TARGET | JUDGE"},
     {"get", stepper_get, METH_O, "get(node) -> the node's value, as run() reads it"},
     {nullptr, nullptr, 0, nullptr},

@@ -166,7 +166,7 @@ void truth_dealloc(PyObject *self_)
 }
 
 PyMethodDef truth_methods[] = {
-    {"line", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)(void)>(truth_line)),
+    {"line", fastcall(truth_line),
      METH_FASTCALL, "line(t_ns, pos, fcs_mode, fcs_fallback, c2_link, gps) -> str or None"},
     {nullptr, nullptr, 0, nullptr},
 };

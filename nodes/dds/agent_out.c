@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "agent__agent.h"
+#include "agent__hmac.h"
 
 int64_t agent_mono_ns(void)
 {
@@ -161,8 +162,12 @@ static void write_guid(FILE *f, const dds_guid_t *g)
  * write in, the node they claimed, how many, and their participant. */
 static void write_refused(const agent_t *a, FILE *f)
 {
-    fprintf(f, "\"security\":%s,\"refused_samples\":%" PRIu64 ",\"refused\":[",
-            a->o.security_dir ? "true" : "false", a->refused_samples);
+    uint64_t reused, derived;
+    agent_hmac_counts(&reused, &derived);
+    fprintf(f,
+            "\"security\":%s,\"session_keys\":{\"reused\":%" PRIu64 ",\"derived\":%" PRIu64
+            "},\"refused_samples\":%" PRIu64 ",\"refused\":[",
+            a->o.security_dir ? "true" : "false", reused, derived, a->refused_samples);
     bool first = true;
     for (int i = 0; i < a->n_writers; i++) {
         const agent_writer_t *w = &a->writers[i];

@@ -137,6 +137,10 @@ def test_the_run_has_its_own_authorities_and_private_keys(clean):
         st = json.loads((clean.run_dir / f"dds{k}.json").read_text())
         assert st["security"] is True and st["refused_samples"] == 0
         assert st["foreign_participants"] == []
+        # the plugin's session keys come from the agent's HMAC(): derived once per peer and
+        # session, then reused for each message (nodes/README.md)
+        keys = st["session_keys"]
+        assert keys["reused"] > 10 * keys["derived"] > 0, keys
 
 
 def test_an_unauthenticated_participant_changes_nothing(launches, clean):

@@ -1,11 +1,13 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* HMAC() for the DDS Security plugin: a session key derived once, not once per message.
+/* HMAC() for the DDS Security plugin: a session key derived once per thread, peer and
+ * session, not once per message.
  *
  * With `sign` (or `encrypt`), Cyclone DDS 0.10's cryptographic plugin derives the sending
  * participant's session key again for every RTPS message it receives: HMAC-SHA256 over the
  * same master key, the same salt and the same session id, with OpenSSL's one-shot HMAC().
  * OpenSSL 3 implements that by fetching the algorithm and building its contexts at every
- * call: about 2 µs a message, a tenth of an agent's CPU in a triplex flight.
+ * call: about 2 µs a message, 9% of an agent's CPU in a triplex flight (perf, with call
+ * graphs: docs/performance.md).
  *
  * The agent defines HMAC() itself and exports it (the link option in CMakeLists.txt). The
  * plugin, loaded later, has its reference bound to the executable's definition, which comes
@@ -15,8 +17,11 @@
  * result is OpenSSL's. Nothing else changes: each message's MAC is still checked with the
  * session key, a tampered message is still refused.
  *
- * The comparisons take the same time whatever bytes differ. The stored keys live as long as
- * their thread (Cyclone's receive thread, the main thread), as the plugin's own copies do. */
+ * A result is found again only while its thread keeps it: 8 per thread, the oldest replaced
+ * first; past 8 peers and sessions at once, each message is derived again, as before. The
+ * digest is known by its object (the plugin's EVP_sha256(), a static one), not its name.
+ * The comparisons take the same time whatever bytes differ. A slot is wiped before it is
+ * used again; the key material it holds otherwise stays until the thread ends. */
 #include <dlfcn.h>
 #include <stdatomic.h>
 #include <stddef.h>
@@ -105,17 +110,21 @@ unsigned char *HMAC(const EVP_MD *md, const void *key, int key_len, const unsign
             return out;
         }
     }
+    /* into a buffer of its own: `out` may be the key or the data (an HMAC in place), which
+     * must be stored as they were given */
+    unsigned char digest[OUT_MAX];
     unsigned int n = 0;
-    unsigned char *r = real(md, key, key_len, data, data_len, out, &n);
-    if (out_len)
-        *out_len = n;
     atomic_fetch_add_explicit(&misses, 1, memory_order_relaxed);
-    if (r != out || n == 0 || n > OUT_MAX)
-        return r; /* failed, or a digest too long to keep: not stored */
+    if (real(md, key, key_len, data, data_len, digest, &n) != digest || n == 0 || n > OUT_MAX) {
+        explicit_bzero(digest, sizeof digest);
+        /* failed (or a digest longer than any OpenSSL has): OpenSSL's answer, unstored */
+        return real(md, key, key_len, data, data_len, out, out_len);
+    }
     entry_t *e = &cache[next_slot];
     next_slot = (next_slot + 1) % ENTRIES;
     if (cached < ENTRIES)
         cached++;
+    explicit_bzero(e, sizeof *e);
     e->md = md;
     e->key_len = (unsigned)key_len;
     e->data_len = (unsigned)data_len;
@@ -123,8 +132,12 @@ unsigned char *HMAC(const EVP_MD *md, const void *key, int key_len, const unsign
     memcpy(e->key, key, (size_t)key_len);
     if (data_len)
         memcpy(e->data, data, data_len);
-    memcpy(e->out, out, n);
-    return r;
+    memcpy(e->out, digest, n);
+    memcpy(out, digest, n);
+    explicit_bzero(digest, sizeof digest);
+    if (out_len)
+        *out_len = n;
+    return out;
 }
 
 void agent_hmac_counts(uint64_t *reused, uint64_t *derived)

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Unit test of the agent's HMAC() (agent_hmac.c): every result is OpenSSL's own, for digests,
- * keys and data of every length it stores and some it does not; a result is reused only for
- * the same digest, key and data; each thread keeps its own. OpenSSL's libcrypto is loaded at
- * run time, as the security plugin loads it into the agent. */
+/* Unit test of the agent's HMAC() (agent_hmac.c): every result is OpenSSL's own, for two
+ * digests, keys and data of every length it stores and some it does not, in place too; a
+ * result is reused only for the same digest, key and data; each thread keeps its own.
+ * OpenSSL's libcrypto is loaded at run time, as the security plugin loads it into the agent. */
 #include <dlfcn.h>
 #include <inttypes.h>
 #include <pthread.h>
@@ -80,23 +80,50 @@ static void test_rfc4231_vector(void)
     CHECK(!memcmp(out, want, 32));
 }
 
+static void fill(unsigned char *b, size_t n, uint32_t y)
+{
+    for (size_t i = 0; i < n; i++)
+        b[i] = (unsigned char)((y = y * 1103515245u + 12345u) >> 16);
+}
+
 static void test_every_length_and_eviction(void)
 {
     unsigned char key[64], data[128];
-    uint32_t x = 12345;
-    for (int round = 0; round < 3; round++) {
-        /* 40 inputs in turn, more than a thread keeps: each is found again or derived again */
-        for (int i = 0; i < 40; i++) {
-            int kl = (i * 7) % 65;
-            size_t dl = (size_t)((i * 13) % 129);
-            uint32_t y = x + (uint32_t)i;
-            for (int b = 0; b < 64; b++)
-                key[b] = (unsigned char)((y = y * 1103515245u + 12345u) >> 16);
-            for (int b = 0; b < 128; b++)
-                data[b] = (unsigned char)((y = y * 1103515245u + 12345u) >> 16);
-            same_as_openssl(i % 3 ? sha256 : sha1, key, kl, data, dl);
-            same_as_openssl(i % 3 ? sha256 : sha1, key, kl, data, dl); /* now stored */
+    /* every key length with every data length it stores, each twice (derived, then stored) */
+    for (int kl = 0; kl <= 64; kl++)
+        for (size_t dl = 0; dl <= 128; dl++) {
+            fill(key, sizeof key, (uint32_t)(kl * 1000 + (int)dl));
+            fill(data, sizeof data, (uint32_t)(kl * 7 + (int)dl * 13));
+            const EVP_MD *md = (kl + dl) % 3 ? sha256 : sha1;
+            same_as_openssl(md, key, kl, data, dl);
+            same_as_openssl(md, key, kl, data, dl);
         }
+    /* 40 inputs in turn, more than a thread keeps: each is derived again, rightly */
+    for (int round = 0; round < 3; round++)
+        for (int i = 0; i < 40; i++) {
+            fill(key, sizeof key, 12345u + (uint32_t)i);
+            fill(data, sizeof data, 54321u + (uint32_t)i);
+            same_as_openssl(i % 3 ? sha256 : sha1, key, (i * 7) % 65, data, (size_t)((i * 13) % 129));
+        }
+}
+
+static void test_in_place(void)
+{
+    /* the digest written over the data, then over the key, round after round: each round's
+     * input differs from the last, and so must its result */
+    unsigned char buf[32], key[32], want[32], kw[32];
+    unsigned int n;
+    fill(buf, sizeof buf, 7);
+    fill(key, sizeof key, 8);
+    memcpy(want, buf, sizeof want);
+    memcpy(kw, key, sizeof kw);
+    for (int i = 0; i < 20; i++) {
+        CHECK(HMAC(sha256, key, 32, buf, 32, buf, &n) == buf && n == 32);
+        CHECK(openssl(sha256, kw, 32, want, 32, want, &n) == want && n == 32);
+        CHECK(!memcmp(buf, want, 32));
+        CHECK(HMAC(sha256, key, 32, buf, 32, key, &n) == key && n == 32);
+        CHECK(openssl(sha256, kw, 32, want, 32, kw, &n) == kw && n == 32);
+        CHECK(!memcmp(key, kw, 32));
     }
 }
 
@@ -191,6 +218,7 @@ int main(void)
     sha1 = s1();
     test_rfc4231_vector();
     test_every_length_and_eviction();
+    test_in_place();
     test_only_the_same_input_is_reused();
     test_what_is_not_stored();
     test_threads_keep_their_own();

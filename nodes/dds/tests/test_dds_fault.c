@@ -6,16 +6,7 @@
 #include <string.h>
 
 #include "agent__fault.h"
-
-static int failures;
-
-#define CHECK(c)                                                                              \
-    do {                                                                                      \
-        if (!(c)) {                                                                           \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #c);             \
-            failures++;                                                                       \
-        }                                                                                     \
-    } while (0)
+#include "dds_test.h"
 
 #define FRAME_NS 50000000LL
 

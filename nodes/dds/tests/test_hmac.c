@@ -10,21 +10,12 @@
 #include <string.h>
 
 #include "agent__hmac.h"
+#include "dds_test.h"
 
 typedef unsigned char *hmac_fn(const EVP_MD *md, const void *key, int key_len,
                                const unsigned char *data, size_t data_len, unsigned char *out,
                                unsigned int *out_len);
 typedef const EVP_MD *md_fn(void);
-
-static int failures;
-
-#define CHECK(c)                                                                              \
-    do {                                                                                      \
-        if (!(c)) {                                                                           \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #c);             \
-            failures++;                                                                       \
-        }                                                                                     \
-    } while (0)
 
 static hmac_fn *openssl;
 static const EVP_MD *sha256, *sha1;

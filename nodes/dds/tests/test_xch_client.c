@@ -19,6 +19,7 @@
 #include "ske_abi.h"
 #include "ske_sandbox.h"
 #include "xch/client.h"
+#include "dds_test.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define SANDBOXED 0
@@ -30,16 +31,6 @@
 #ifndef SANDBOXED
 #define SANDBOXED 1
 #endif
-
-static int failures;
-
-#define CHECK(cond)                                                                           \
-    do {                                                                                      \
-        if (!(cond)) {                                                                        \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);          \
-            failures++;                                                                       \
-        }                                                                                     \
-    } while (0)
 
 /* ---- the child: an io partition ------------------------------------------------------ */
 

@@ -6,15 +6,7 @@
 #include <inttypes.h>
 #include <stdio.h>
 
-static int failures;
-
-#define CHECK(cond)                                                                           \
-    do {                                                                                      \
-        if (!(cond)) {                                                                        \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);          \
-            failures++;                                                                       \
-        }                                                                                     \
-    } while (0)
+#include "unit_check.h"
 
 #define CHECK_EQ(a, e)                                                                        \
     do {                                                                                      \

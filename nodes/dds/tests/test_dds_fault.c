@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "agent__fault.h"
-#include "dds_test.h"
+#include "../../tests/unit_check.h"
 
 #define FRAME_NS 50000000LL
 

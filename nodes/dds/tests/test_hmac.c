@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "agent__hmac.h"
-#include "dds_test.h"
+#include "../../tests/unit_check.h"
 
 typedef unsigned char *hmac_fn(const EVP_MD *md, const void *key, int key_len,
                                const unsigned char *data, size_t data_len, unsigned char *out,

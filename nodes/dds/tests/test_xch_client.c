@@ -19,7 +19,7 @@
 #include "ske_abi.h"
 #include "ske_sandbox.h"
 #include "xch/client.h"
-#include "dds_test.h"
+#include "../../tests/unit_check.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define SANDBOXED 0

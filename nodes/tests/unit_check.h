@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Checks of the DDS agent's unit tests: a failed one is reported with its place and counted. */
-#ifndef DDS_TEST_H
-#define DDS_TEST_H
+/* Checks of the nodes' C unit tests (the CAN bus's, the DDS agent's): a failed one is reported
+ * with its place and counted. */
+#ifndef NODES_UNIT_CHECK_H
+#define NODES_UNIT_CHECK_H
 
 #include <stdio.h>
 

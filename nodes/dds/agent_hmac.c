@@ -115,10 +115,9 @@ unsigned char *HMAC(const EVP_MD *md, const void *key, int key_len, const unsign
     unsigned char digest[OUT_MAX];
     unsigned int n = 0;
     atomic_fetch_add_explicit(&misses, 1, memory_order_relaxed);
-    if (real(md, key, key_len, data, data_len, digest, &n) != digest || n == 0 || n > OUT_MAX) {
+    if (real(md, key, key_len, data, data_len, digest, &n) != digest || n == 0) {
         explicit_bzero(digest, sizeof digest);
-        /* failed (or a digest longer than any OpenSSL has): OpenSSL's answer, unstored */
-        return real(md, key, key_len, data, data_len, out, out_len);
+        return NULL; /* OpenSSL's answer: failed */
     }
     entry_t *e = &cache[next_slot];
     next_slot = (next_slot + 1) % ENTRIES;

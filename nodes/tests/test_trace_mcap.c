@@ -9,16 +9,7 @@
 #include <string.h>
 
 #include "trace_mcap/trace_mcap.h"
-
-static int failures;
-
-#define CHECK(cond)                                                              \
-    do {                                                                         \
-        if (!(cond)) {                                                           \
-            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond); \
-            failures++;                                                          \
-        }                                                                        \
-    } while (0)
+#include "unit_check.h"
 
 static const char FRAME[] =
     "{\"t_ns\":480000,\"node\":\"canbus\",\"src\":\"canbus\",\"kind\":\"can_tx\","

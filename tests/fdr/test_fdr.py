@@ -8,12 +8,10 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import signal
 import subprocess
 import sys
 import time
-import warnings
 from pathlib import Path
 
 import pytest
@@ -24,6 +22,10 @@ from ima.launch import run as launch_run
 from ima.launch.options import LaunchOptions
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "tests" / "flight"))  # the flight tests' helpers
+
+from flight_helpers import fly_unless_host_stalled  # noqa: E402
+
 TRIPLEX = ROOT / "config" / "systems" / "rpas_triplex.yaml"
 PILOT = ROOT / "sim" / "pilots" / "workload_autopilot.yaml"
 DURATION = 10.0
@@ -133,22 +135,6 @@ def test_a_recording_survives_kill_9_of_the_whole_run(tmp_path):
     assert s["torn"] <= 1 and s["tail_bytes"] < records.RECORD_SIZE, s  # at most the last one
 
 
-def _host_stalls(run_dir: Path) -> list[dict]:
-    """CPU-budget overruns in a run's node traces of any partition but node1's recorder (the
-    one the faults below act on). These partitions use a tiny part of their budgets; one that
-    still overran was stalled on the host's account (a preempted virtual CPU), not by the
-    recorder's loss."""
-    out = []
-    for trace in sorted(run_dir.glob("node*.jsonl")):
-        with open(trace) as f:
-            for line in f:
-                if '"kind":"overrun"' in line and '"cause":"cpu_budget"' in line:
-                    e = json.loads(line)
-                    if (trace.stem, e.get("partition")) != ("node1", "fdr"):
-                        out.append(dict(e, trace=trace.name))
-    return out
-
-
 @pytest.mark.parametrize("spec", ["fdr@node1:partition_crash@3~1", "fdr@node1:partition_crash@3",
                                   "fdr@node1:cpu_overrun@3~2", "fdr@node1:partition_hang@3~1",
                                   "fdr@node1:disk_full@3~2"],
@@ -167,15 +153,8 @@ def test_the_recorders_loss_changes_nothing(spec, tmp_path):
         assert p.returncode == 0, p.stderr[-2000:]
         return json.loads(p.stdout)
 
-    s = fly()
-    stalls = _host_stalls(run_dir) + _host_stalls(run_dir / "golden")
-    if stalls:
-        # the flight tests' rule (tests/flight/flight_helpers.py): flown again, once, when the
-        # host stalled a partition the fault does not act on; that flight is judged as is
-        warnings.warn(f"{spec}: flown again, the host stalled a partition past its CPU "
-                      f"budget: {stalls[0]}", stacklevel=1)
-        shutil.rmtree(run_dir)
-        s = fly()
+    # flown again, once, when the host stalled a partition the fault does not act on
+    s = fly_unless_host_stalled(fly, run_dir, spec, targets=frozenset({("node1", "fdr")}))
     o = s["oracles"]
     assert s["faults"][0]["applied"], s["faults"]
     assert o["envelope"]["truth_identical"], o["envelope"]

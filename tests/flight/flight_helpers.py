@@ -72,26 +72,31 @@ def dump(f) -> str:
     return json.dumps(s, indent=1)
 
 
-def host_stalls(run_dir) -> list[dict]:
-    """The SKE's CPU-budget overruns in the run's node traces. The partitions of these flights
+def host_stalls(run_dir, targets: frozenset = frozenset()) -> list[dict]:
+    """The SKE's CPU-budget overruns in the run's node traces, and in those of its golden run
+    (RUN_DIR/golden, a run with faults judged against it), but for the (node, partition)
+    pairs in `targets` (the ones a fault overruns on purpose). The partitions of these flights
     use a tiny part of their budgets (io some 20 µs of CPU per 5 ms window); one that still
     overran was stalled in the kernel on the host's account (direct reclaim, a preempted
     virtual CPU), not by anything under test. A run with one is flown again, once."""
+    run_dir = Path(run_dir)
     out = []
-    for trace in sorted(Path(run_dir).glob("node*.jsonl")):
+    for trace in sorted([*run_dir.glob("node*.jsonl"), *run_dir.glob("golden/node*.jsonl")]):
         with open(trace) as f:
             for line in f:
                 if '"kind":"overrun"' in line and '"cause":"cpu_budget"' in line:
-                    out.append(dict(json.loads(line), trace=trace.name))
+                    e = json.loads(line)
+                    if (trace.stem, e.get("partition")) not in targets:
+                        out.append(dict(e, trace=str(trace.relative_to(run_dir))))
     return out
 
 
-def fly_unless_host_stalled(fly, run_dir, name: str):
+def fly_unless_host_stalled(fly, run_dir, name: str, targets: frozenset = frozenset()):
     """`fly()`, which flies into run_dir; once more, into a fresh run_dir, if the host stalled a
-    partition past its CPU budget (host_stalls), with a warning that names the stall. Returns
-    the last flight's result; a stall in that one is the tests' to judge."""
+    partition past its CPU budget (host_stalls, but for `targets`), with a warning that names
+    the stall. Returns the last flight's result; a stall in that one is the tests' to judge."""
     result = fly()
-    stalls = host_stalls(run_dir)
+    stalls = host_stalls(run_dir, targets)
     if stalls:
         warnings.warn(f"{name}: flown again, the host stalled a partition past its CPU "
                       f"budget: {stalls[0]}", stacklevel=2)

@@ -46,3 +46,14 @@ def test_a_host_stall_is_flown_again_once_with_a_warning(tmp_path):
 def test_other_overruns_are_not_host_stalls(tmp_path):
     (tmp_path / "node2.jsonl").write_text(json.dumps(WINDOW_END, separators=(",", ":")) + "\n")
     assert host_stalls(tmp_path) == []
+
+
+def test_a_golden_runs_stall_counts_and_a_targets_does_not(tmp_path):
+    (tmp_path / "golden").mkdir()
+    (tmp_path / "golden" / "node3.jsonl").write_text(
+        json.dumps(dict(STALL, node="node3"), separators=(",", ":")) + "\n")
+    (tmp_path / "node1.jsonl").write_text(
+        json.dumps(dict(STALL, partition="fdr"), separators=(",", ":")) + "\n")
+    assert [s["trace"] for s in host_stalls(tmp_path)] == ["golden/node3.jsonl", "node1.jsonl"]
+    stalls = host_stalls(tmp_path, frozenset({("node1", "fdr")}))
+    assert [s["trace"] for s in stalls] == ["golden/node3.jsonl"]

@@ -17,6 +17,7 @@ import os
 import select
 import signal
 import sys
+import time
 from pathlib import Path
 
 from ima.errors import ImaError
@@ -44,6 +45,11 @@ class _Stdin:
         if not self.ended:
             self._read(0)
         return self.ended
+
+    def wait_ended(self, timeout: float) -> None:
+        """Up to `timeout`, less if the word comes: the recorder's last reads start at once."""
+        if not self.ended:
+            self._read(timeout)
 
     def wait_closed(self) -> None:
         while not self.closed:
@@ -80,6 +86,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         counts = write.record(args.run_dir, before_verdicts=wait,
                               follow=stdin.run_ended if args.follow else None,
+                              wait=stdin.wait_ended if args.follow else time.sleep,
                               nodes=args.nodes.split(",") if args.nodes else None)
     except ImaError as e:
         print(f"ima: recording: {e}", file=sys.stderr)

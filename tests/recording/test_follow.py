@@ -1,0 +1,55 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Following a run's traces (recording/follow.py) and the launcher's word to the recorder
+(recording/__main__.py): the recorder reads what is left as soon as it is told the run has
+ended, not after the rest of a poll's sleep."""
+
+from __future__ import annotations
+
+import os
+import time
+
+from ima.recording import follow
+from ima.recording.__main__ import _Stdin
+
+
+def test_feed_until_waits_with_the_given_wait_and_reads_the_rest_once_ended(tmp_path):
+    trace = tmp_path / "t.jsonl"
+    trace.write_bytes(b'{"a":1}\n{"a":2}\n{"a"')  # a line still being written
+    got: list[tuple[int, bytes]] = []
+    waits: list[float] = []
+    state = {"ended": False}
+
+    def wait(timeout: float) -> None:
+        waits.append(timeout)
+        with open(trace, "ab") as f:  # the writer ends its line, then the run ends
+            f.write(b':3}\n{"a":4')
+        state["ended"] = True
+
+    follow.feed_until([(trace, lambda b: got.extend(b.lines()))], lambda: state["ended"],
+                      0.05, wait)
+    assert waits == [0.05]  # one read, one wait, then the rest: no second wait
+    assert got == [(0, b'{"a":1}'), (1, b'{"a":2}'), (2, b'{"a":3}'), (3, b'{"a":4')]
+
+
+def test_the_recorder_wait_returns_when_the_launcher_says_ended(monkeypatch):
+    r, w = os.pipe()
+    try:
+        monkeypatch.setattr("sys.stdin", os.fdopen(r, "rb", buffering=0, closefd=False))
+        stdin = _Stdin()
+        t0 = time.monotonic()
+        stdin.wait_ended(0.05)  # nothing said: the whole timeout
+        assert time.monotonic() - t0 >= 0.04 and not stdin.ended
+        os.write(w, b"ended\n")
+        t0 = time.monotonic()
+        stdin.wait_ended(30.0)  # told: at once, not after 30 s
+        assert time.monotonic() - t0 < 5.0
+        assert stdin.ended and stdin.run_ended() and not stdin.closed
+        stdin.wait_ended(30.0)  # once ended, it no longer waits
+        os.close(w)
+        w = -1
+        stdin.wait_closed()  # end of file: the summary is final
+        assert stdin.closed
+    finally:
+        if w >= 0:
+            os.close(w)
+        os.close(r)

@@ -22,7 +22,6 @@
  * digest is known by its object (the plugin's EVP_sha256(), a static one), not its name.
  * The comparisons take the same time whatever bytes differ. A slot is wiped before it is
  * used again; the key material it holds otherwise stays until the thread ends. */
-#include <dlfcn.h>
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -30,6 +29,7 @@
 #include <string.h>
 
 #include "agent__hmac.h"
+#include "agent__libcrypto.h"
 
 #define KEY_MAX 64   /* bytes of key and of data kept; longer ones are not stored */
 #define DATA_MAX 128
@@ -50,20 +50,14 @@ static _Thread_local entry_t cache[ENTRIES];
 static _Thread_local unsigned cached, next_slot;
 static atomic_uint_fast64_t hits, misses;
 
-/* OpenSSL's HMAC(): the next definition after the executable's, else libcrypto's own (a
- * plugin loaded with RTLD_LOCAL keeps libcrypto out of the global scope). */
+/* OpenSSL's HMAC() (agent__libcrypto.h). */
 static hmac_fn *openssl_hmac(void)
 {
     static hmac_fn *_Atomic fn;
     hmac_fn *f = atomic_load_explicit(&fn, memory_order_acquire);
     if (f)
         return f;
-    f = (hmac_fn *)dlsym(RTLD_NEXT, "HMAC");
-    if (!f) {
-        void *lib = dlopen("libcrypto.so.3", RTLD_NOW | RTLD_NOLOAD);
-        if (lib)
-            f = (hmac_fn *)dlsym(lib, "HMAC");
-    }
+    f = (hmac_fn *)agent_libcrypto_sym("HMAC");
     if (!f) {
         static atomic_flag told = ATOMIC_FLAG_INIT;
         if (!atomic_flag_test_and_set(&told))

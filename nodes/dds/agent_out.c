@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "agent__agent.h"
+#include "agent__cipher.h"
 #include "agent__hmac.h"
 
 int64_t agent_mono_ns(void)
@@ -162,12 +163,15 @@ static void write_guid(FILE *f, const dds_guid_t *g)
  * write in, the node they claimed, how many, and their participant. */
 static void write_refused(const agent_t *a, FILE *f)
 {
-    uint64_t reused, derived;
+    uint64_t reused, derived, prefetched, as_given;
     agent_hmac_counts(&reused, &derived);
+    agent_cipher_counts(&prefetched, &as_given);
     fprintf(f,
             "\"security\":%s,\"session_keys\":{\"reused\":%" PRIu64 ",\"derived\":%" PRIu64
+            "},\"cipher_inits\":{\"prefetched\":%" PRIu64 ",\"as_given\":%" PRIu64
             "},\"refused_samples\":%" PRIu64 ",\"refused\":[",
-            a->o.security_dir ? "true" : "false", reused, derived, a->refused_samples);
+            a->o.security_dir ? "true" : "false", reused, derived, prefetched, as_given,
+            a->refused_samples);
     bool first = true;
     for (int i = 0; i < a->n_writers; i++) {
         const agent_writer_t *w = &a->writers[i];

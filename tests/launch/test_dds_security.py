@@ -156,6 +156,10 @@ def test_the_run_has_its_own_authorities_and_private_keys(clean):
         # session, then reused for each message (nodes/README.md)
         keys = st["session_keys"]
         assert keys["reused"] > 10 * keys["derived"] > 0, keys
+        # and the AES-GCM implementation from its cipher initialisations: fetched once, not
+        # at each message; no other cipher is asked for
+        inits = st["cipher_inits"]
+        assert inits["prefetched"] > keys["reused"] and inits["as_given"] == 0, inits
 
 
 def test_an_unauthenticated_participant_changes_nothing(launches, clean):

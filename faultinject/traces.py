@@ -435,9 +435,9 @@ class RunTraces:
     @functools.cached_property
     def dds(self) -> dict[str, list[dict]]:
         """Each agent's trace up to the end of the run: what it saw of the run. At the end the
-        nodes stop, then the agents one by one: those stopped later see the first ones go
-        (`dds_peer_lost`, writer gone), and on a loaded host the agents may idle past their
-        liveliness lease between the two (`dds_peer_lost`, liveliness). Every trace is cut
+        nodes stop, then the agents (each traces the others' going as `dds_peer_left`), and on
+        a loaded host the agents may idle past their liveliness lease between the two
+        (`dds_peer_lost`, liveliness). Every trace is cut
         where the run ended for the first agent (the wall-clock time of the first
         `io_disconnect` or `dds_stop` of the run's last frame), each at its own `dds_stop` at
         the latest."""

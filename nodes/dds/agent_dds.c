@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <inttypes.h>
 #include <net/if.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
@@ -275,6 +276,15 @@ unsigned agent_dds_bind_sockets(agent_t *a)
 
 /* ---- peers ----------------------------------------------------------------------------- */
 
+/* Told to stop: SIGINT or SIGTERM read, or waiting to be (blocked in every thread, it stays
+ * pending for the main thread's signalfd; a listener may run first). */
+static bool stopping(const agent_t *a)
+{
+    sigset_t pending;
+    return a->stop || (sigpending(&pending) == 0 &&
+                       (sigismember(&pending, SIGTERM) == 1 || sigismember(&pending, SIGINT) == 1));
+}
+
 static void peer_lost(agent_t *a, unsigned k, const char *reason)
 {
     if (k < 1 || k > a->o.nodes || k == a->o.node)
@@ -284,6 +294,16 @@ static void peer_lost(agent_t *a, unsigned k, const char *reason)
     p->alive = false;
     if (p->dead)
         return;
+    if (stopping(a)) {
+        /* The run is ending: the launcher stops every agent at once (their SIGTERMs all
+         * pending before any runs on), and a peer's agent may be gone before this one. That
+         * is the end, not a loss: nothing is latched. */
+        if (agent_trace_begin(a, "dds_peer_left")) {
+            fprintf(a->trace, ",\"peer\":\"node%u\",\"reason\":\"%s\"", k, reason);
+            agent_trace_end(a);
+        }
+        return;
+    }
     p->dead = true;
     p->lost_wall_ns = agent_wall_ns();
     agree_set_dead(&a->agree, k);

@@ -107,9 +107,14 @@ class Processes:
                 pass
 
     def stop(self) -> None:
-        """SIGTERM, a grace period, then SIGKILL to whole groups: nothing is left behind."""
+        """SIGTERM, a grace period, then SIGKILL to whole groups: nothing is left behind.
+        Every group is stopped first and continued last, so that each has its SIGTERM before
+        any runs on: a DDS agent that sees another leave knows then that the run is ending
+        (nodes/README.md), whichever of them the CPU takes first. A frozen process takes its
+        SIGTERM at the SIGCONT too."""
+        self.signal_all(signal.SIGSTOP)
         self.signal_all(signal.SIGTERM)
-        self.signal_all(signal.SIGCONT)  # a frozen process takes its SIGTERM now
+        self.signal_all(signal.SIGCONT)
         self.wait_all(5.0)
         self.signal_all(signal.SIGKILL)
         self.wait_all(5.0)

@@ -111,10 +111,13 @@ class Processes:
         Every group is stopped first and continued last, so that each has its SIGTERM before
         any runs on: a DDS agent that sees another leave knows then that the run is ending
         (nodes/README.md), whichever of them the CPU takes first. A frozen process takes its
-        SIGTERM at the SIGCONT too."""
-        self.signal_all(signal.SIGSTOP)
-        self.signal_all(signal.SIGTERM)
-        self.signal_all(signal.SIGCONT)
+        SIGTERM at the SIGCONT too. Whatever interrupts this (Ctrl-C), every group is
+        continued: none is left stopped."""
+        try:
+            self.signal_all(signal.SIGSTOP)
+            self.signal_all(signal.SIGTERM)
+        finally:
+            self.signal_all(signal.SIGCONT)
         self.wait_all(5.0)
         self.signal_all(signal.SIGKILL)
         self.wait_all(5.0)

@@ -201,26 +201,30 @@ class BusClient:
         """
         frames: list[Frame] = []
         if timeout is None and not self._pending and self.stopped is None:
-            # Fast path: most quanta bring one datagram with the TICK alone, or frames + TICK.
-            try:
-                buf = self._sock.recv(proto.MAX_DATAGRAM)
-            except OSError as e:
-                raise BusError(f"lost the CAN bus at {self.path}: {e}") from e
-            n = len(buf)
-            if n == _REC_SIZE and buf[0] == _MSG_TICK:
-                r = _unpack(buf)
-                return Tick(r[6], r[5], frames)
-            if n and n % _REC_SIZE == 0 and buf[n - _REC_SIZE] == _MSG_TICK:
-                for r in _iter_unpack(buf):
-                    t = r[0]
-                    if t == _MSG_FRAME:
-                        frames.append(Frame(r[4], r[7][:r[2]], r[5], r[6], r[3], r[1]))
-                    elif t == _MSG_TICK:
-                        return Tick(r[6], r[5], frames)
-                    else:  # STOP or ERROR before the TICK: take the general path
-                        frames = []
-                        break
-            self._push(buf)
+            # Fast path: most quanta bring one datagram with the TICK alone, or frames + TICK;
+            # the quanta a client is not granted bring their frames alone, before the TICK.
+            # Anything else (a STOP, an ERROR, a short datagram) takes the general path below,
+            # with the frames taken so far.
+            while True:
+                try:
+                    buf = self._sock.recv(proto.MAX_DATAGRAM)
+                except OSError as e:
+                    raise BusError(f"lost the CAN bus at {self.path}: {e}") from e
+                n = len(buf)
+                if n == _REC_SIZE and buf[0] == _MSG_TICK:
+                    r = _unpack(buf)
+                    return Tick(r[6], r[5], frames)
+                if n and n % _REC_SIZE == 0:
+                    types = buf[::_REC_SIZE]  # each record's type, its first byte
+                    m = types.count(_MSG_FRAME)
+                    if m == len(types) or (m == len(types) - 1 and types[-1] == _MSG_TICK):
+                        for r in _iter_unpack(buf):
+                            if r[0] != _MSG_FRAME:  # the TICK, last
+                                return Tick(r[6], r[5], frames)
+                            frames.append(Frame(r[4], r[7][:r[2]], r[5], r[6], r[3], r[1]))
+                        continue  # frames alone: their TICK comes next
+                self._push(buf)
+                break
         while True:
             got, tick = self._frames_until(True)
             frames += got

@@ -437,10 +437,9 @@ class RunTraces:
         """Each agent's trace up to the end of the run: what it saw of the run. At the end the
         nodes stop, then the agents (each traces the others' going as `dds_peer_left`), and on
         a loaded host the agents may idle past their liveliness lease between the two
-        (`dds_peer_lost`, liveliness). Every trace is cut
-        where the run ended for the first agent (the wall-clock time of the first
-        `io_disconnect` or `dds_stop` of the run's last frame), each at its own `dds_stop` at
-        the latest."""
+        (`dds_peer_lost`, liveliness). Every trace is cut where the run ended for the first
+        agent (the wall-clock time of the first `io_disconnect` or `dds_stop` of the run's
+        last frame), each at its own `dds_stop` at the latest."""
         traces = {n: read_jsonl(self.run_dir / f"dds{k}.jsonl")
                   for k, n in enumerate(self.nodes, start=1)}
         last = max((e.get("t_ns", 0) for events in traces.values() for e in events), default=0)

@@ -86,6 +86,7 @@ typedef struct {
     bool matched[T_COUNT];
     bool alive;          /* its inputs writer is alive on DDS */
     bool dead;           /* latched */
+    bool left;           /* gone once this agent was told to stop (traced once) */
     bool deadline_missed;/* a NodeHealth deadline miss traced, no sample since */
     int64_t last_rx_ns;  /* CLOCK_MONOTONIC of its latest sample taken, any topic */
     bool heard;          /* a sample of it has come, any topic */

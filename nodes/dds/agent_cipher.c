@@ -16,9 +16,18 @@
  * the process's life; everything else, and every argument but the cipher, goes to OpenSSL
  * as given. OpenSSL would have used the very implementation it fetched: every MAC, every
  * check and every ciphertext is the same. An ENGINE that registers AES-GCM still takes over
- * (OpenSSL asks for one by the cipher's identifier, the same for both objects). */
+ * (OpenSSL asks for one by the cipher's identifier, the same for both objects). A context
+ * bound to an ENGINE by an earlier initialisation would take OpenSSL's legacy path, which the
+ * fetched implementation does not serve; the agent uses no ENGINE, and the plugin makes a new
+ * context for each message.
+ *
+ * Being the executable's, these definitions are every caller's in the process, not the
+ * plugin's alone (libcrypto's own calls too, unless it binds its symbols to itself): each
+ * call is OpenSSL's with that one argument swapped, and `cipher_inits.as_given` counts the
+ * initialisations with any other cipher (none in a flight). */
 #include <pthread.h>
 #include <stdatomic.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -38,25 +47,37 @@ static struct {
     const EVP_CIPHER *legacy[2];          /* EVP_aes_128_gcm(), EVP_aes_256_gcm() */
     EVP_CIPHER *fetched[2];               /* their implementations, or NULL */
 } ossl;
-static pthread_once_t once = PTHREAD_ONCE_INIT;
+static pthread_mutex_t lookup = PTHREAD_MUTEX_INITIALIZER;
+static atomic_bool ready; /* ossl is complete: read without the lock from then on */
 static atomic_uint_fast64_t prefetched, as_given;
 
-static void look_up(void)
+/* OpenSSL's functions and the two implementations, looked up at the first call that finds
+ * libcrypto loaded (until then, each call tries again). */
+static bool look_up(void)
 {
-    ossl.encrypt_init = (init_fn *)agent_libcrypto_sym("EVP_EncryptInit_ex");
-    ossl.decrypt_init = (init_fn *)agent_libcrypto_sym("EVP_DecryptInit_ex");
-    fetch_fn *fetch = (fetch_fn *)agent_libcrypto_sym("EVP_CIPHER_fetch");
-    nid_fn *nid = (nid_fn *)agent_libcrypto_sym("EVP_CIPHER_get_nid");
-    sn_fn *short_name = (sn_fn *)agent_libcrypto_sym("OBJ_nid2sn");
-    const char *names[2] = {"EVP_aes_128_gcm", "EVP_aes_256_gcm"};
-    for (int i = 0; i < 2; i++) {
-        cipher_fn *legacy = (cipher_fn *)agent_libcrypto_sym(names[i]);
-        if (!legacy || !fetch || !nid || !short_name)
-            continue; /* passed on as given: OpenSSL fetches, as without the agent's */
-        ossl.legacy[i] = legacy();
-        const char *sn = ossl.legacy[i] ? short_name(nid(ossl.legacy[i])) : NULL;
-        ossl.fetched[i] = sn ? fetch(NULL, sn, "") : NULL;
+    if (atomic_load_explicit(&ready, memory_order_acquire))
+        return true;
+    pthread_mutex_lock(&lookup);
+    if (!atomic_load_explicit(&ready, memory_order_relaxed)) {
+        ossl.encrypt_init = (init_fn *)agent_libcrypto_sym("EVP_EncryptInit_ex");
+        ossl.decrypt_init = (init_fn *)agent_libcrypto_sym("EVP_DecryptInit_ex");
+        fetch_fn *fetch = (fetch_fn *)agent_libcrypto_sym("EVP_CIPHER_fetch");
+        nid_fn *nid = (nid_fn *)agent_libcrypto_sym("EVP_CIPHER_get_nid");
+        sn_fn *short_name = (sn_fn *)agent_libcrypto_sym("OBJ_nid2sn");
+        const char *names[2] = {"EVP_aes_128_gcm", "EVP_aes_256_gcm"};
+        for (int i = 0; ossl.encrypt_init && ossl.decrypt_init && i < 2; i++) {
+            cipher_fn *legacy = (cipher_fn *)agent_libcrypto_sym(names[i]);
+            if (!legacy || !fetch || !nid || !short_name)
+                continue; /* passed on as given: OpenSSL fetches, as without the agent's */
+            ossl.legacy[i] = legacy();
+            const char *sn = ossl.legacy[i] ? short_name(nid(ossl.legacy[i])) : NULL;
+            ossl.fetched[i] = sn ? fetch(NULL, sn, "") : NULL; /* kept for the process's life */
+        }
+        if (ossl.encrypt_init && ossl.decrypt_init)
+            atomic_store_explicit(&ready, true, memory_order_release);
     }
+    pthread_mutex_unlock(&lookup);
+    return atomic_load_explicit(&ready, memory_order_acquire);
 }
 
 static const EVP_CIPHER *implementation(const EVP_CIPHER *type, const ENGINE *impl)
@@ -84,8 +105,7 @@ static int missing(const char *name)
 int EVP_EncryptInit_ex(EVP_CIPHER_CTX *ctx, const EVP_CIPHER *type, ENGINE *impl,
                        const unsigned char *key, const unsigned char *iv)
 {
-    pthread_once(&once, look_up);
-    if (!ossl.encrypt_init)
+    if (!look_up())
         return missing("EVP_EncryptInit_ex");
     return ossl.encrypt_init(ctx, implementation(type, impl), impl, key, iv);
 }
@@ -93,8 +113,7 @@ int EVP_EncryptInit_ex(EVP_CIPHER_CTX *ctx, const EVP_CIPHER *type, ENGINE *impl
 int EVP_DecryptInit_ex(EVP_CIPHER_CTX *ctx, const EVP_CIPHER *type, ENGINE *impl,
                        const unsigned char *key, const unsigned char *iv)
 {
-    pthread_once(&once, look_up);
-    if (!ossl.decrypt_init)
+    if (!look_up())
         return missing("EVP_DecryptInit_ex");
     return ossl.decrypt_init(ctx, implementation(type, impl), impl, key, iv);
 }

@@ -285,24 +285,26 @@ static bool stopping(const agent_t *a)
                        (sigismember(&pending, SIGTERM) == 1 || sigismember(&pending, SIGINT) == 1));
 }
 
-static void peer_lost(agent_t *a, unsigned k, const char *reason)
+/* Latches peer k dead (true), unless it is already or this agent is stopping (false). */
+static bool peer_lost(agent_t *a, unsigned k, const char *reason)
 {
     if (k < 1 || k > a->o.nodes || k == a->o.node)
-        return;
+        return false;
     agent_peer_t *p = &a->peer[k - 1];
     bool was_alive = p->alive;
     p->alive = false;
     if (p->dead)
-        return;
+        return false;
     if (stopping(a)) {
         /* The run is ending: the launcher stops every agent at once (their SIGTERMs all
          * pending before any runs on), and a peer's agent may be gone before this one. That
-         * is the end, not a loss: nothing is latched. */
-        if (agent_trace_begin(a, "dds_peer_left")) {
+         * is the end, not a loss: nothing is latched, and it is traced once per peer. */
+        if (!p->left && agent_trace_begin(a, "dds_peer_left")) {
             fprintf(a->trace, ",\"peer\":\"node%u\",\"reason\":\"%s\"", k, reason);
             agent_trace_end(a);
         }
-        return;
+        p->left = true;
+        return false;
     }
     p->dead = true;
     p->lost_wall_ns = agent_wall_ns();
@@ -313,6 +315,7 @@ static void peer_lost(agent_t *a, unsigned k, const char *reason)
         agent_trace_end(a);
     }
     agent_log(a, "node%u lost on DDS (%s): no longer waited for", k, reason);
+    return true;
 }
 
 /* A hung processor: its agent lives on (its DDS liveliness holds) but its partitions are
@@ -330,8 +333,7 @@ bool agent_dds_declare_hung(agent_t *a, uint32_t missing)
         int64_t since = p->last_rx_ns > a->pend_start_ns ? p->last_rx_ns : a->pend_start_ns;
         if (now - since < a->o.lease_ns)
             continue;
-        peer_lost(a, k, "hung");
-        any = true;
+        any |= peer_lost(a, k, "hung");
     }
     return any;
 }

@@ -131,6 +131,9 @@ def test_frames_of_quanta_not_granted_come_with_the_next_tick(tmp_path):
         proto.pack_rec(proto.MSG_STOP, proto.STOP_END, 60_000),
     ])
     c = BusClient(str(sock), "world", LOCK)
+    general = []  # the datagrams left to the general path
+    push = c._push
+    c._push = lambda buf: (general.append(buf[::proto.REC_SIZE]), push(buf))
     try:
         t = c.wait_tick()
         assert (t.t_from, t.t_until) == (20_000, 30_000)
@@ -146,6 +149,9 @@ def test_frames_of_quanta_not_granted_come_with_the_next_tick(tmp_path):
         assert c.wait_tick() is None
         assert (c.stopped, c.stop_t_ns) == (proto.STOP_END, 60_000)
         assert [f.id for f in c.unticked] == [6]
+        # frames alone and frames + TICK on the fast path; the ERROR's and the STOP's not
+        assert general == [bytes([proto.MSG_FRAME, proto.MSG_ERROR, proto.MSG_TICK]),
+                           bytes([proto.MSG_STOP])]
     finally:
         c.close()
         server.join(5)

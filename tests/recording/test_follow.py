@@ -12,22 +12,22 @@ from ima.recording import follow
 from ima.recording.__main__ import _Stdin
 
 
-def test_feed_until_waits_with_the_given_wait_and_reads_the_rest_once_ended(tmp_path):
+def test_feed_until_pauses_as_told_and_reads_the_rest_once_ended(tmp_path):
     trace = tmp_path / "t.jsonl"
     trace.write_bytes(b'{"a":1}\n{"a":2}\n{"a"')  # a line still being written
     got: list[tuple[int, bytes]] = []
-    waits: list[float] = []
+    pauses: list[float] = []
     state = {"ended": False}
 
-    def wait(timeout: float) -> None:
-        waits.append(timeout)
+    def pause(timeout: float) -> None:
+        pauses.append(timeout)
         with open(trace, "ab") as f:  # the writer ends its line, then the run ends
             f.write(b':3}\n{"a":4')
         state["ended"] = True
 
     follow.feed_until([(trace, lambda b: got.extend(b.lines()))], lambda: state["ended"],
-                      0.05, wait)
-    assert waits == [0.05]  # one read, one wait, then the rest: no second wait
+                      0.05, pause)
+    assert pauses == [0.05]  # one read, one pause, then the rest: no second pause
     assert got == [(0, b'{"a":1}'), (1, b'{"a":2}'), (2, b'{"a":3}'), (3, b'{"a":4')]
 
 

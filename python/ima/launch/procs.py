@@ -54,6 +54,13 @@ def frozen(pid: int) -> bool:
     return stat[stat.rfind(")") + 2:][:1] == "T"
 
 
+def _killpg(pgid: int, signum: int) -> None:
+    try:
+        os.killpg(pgid, signum)
+    except ProcessLookupError:  # the whole group has ended
+        pass
+
+
 class Processes:
     """The run's child processes by name ("canbus", "world", "node2", "node2/dds")."""
 
@@ -87,10 +94,7 @@ class Processes:
     def kill_group(self, name: str, signum: int = signal.SIGKILL) -> None:
         proc = self.procs.get(name)
         if proc is not None and proc.poll() is None:
-            try:
-                os.killpg(proc.pid, signum)
-            except ProcessLookupError:
-                pass
+            _killpg(proc.pid, signum)
 
     def signal_all(self, signum: int) -> None:
         for name in self.procs:
@@ -111,13 +115,19 @@ class Processes:
         Every group is stopped first and continued last, so that each has its SIGTERM before
         any runs on: a DDS agent that sees another leave knows then that the run is ending
         (nodes/README.md), whichever of them the CPU takes first. A frozen process takes its
-        SIGTERM at the SIGCONT too. Whatever interrupts this (Ctrl-C), every group is
-        continued: none is left stopped."""
+        SIGTERM at the SIGCONT too. Every group stopped is continued, its leader ended or
+        not, whatever interrupts the SIGTERMs (Ctrl-C)."""
+        stopped = []
         try:
-            self.signal_all(signal.SIGSTOP)
-            self.signal_all(signal.SIGTERM)
+            for proc in self.procs.values():
+                if proc.poll() is None:
+                    stopped.append(proc.pid)
+                    _killpg(proc.pid, signal.SIGSTOP)
+            for pid in stopped:
+                _killpg(pid, signal.SIGTERM)
         finally:
-            self.signal_all(signal.SIGCONT)
+            for pid in stopped:
+                _killpg(pid, signal.SIGCONT)
         self.wait_all(5.0)
         self.signal_all(signal.SIGKILL)
         self.wait_all(5.0)

@@ -86,7 +86,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         counts = write.record(args.run_dir, before_verdicts=wait,
                               follow=stdin.run_ended if args.follow else None,
-                              wait=stdin.wait_ended if args.follow else time.sleep,
+                              pause=stdin.wait_ended if args.follow else time.sleep,
                               nodes=args.nodes.split(",") if args.nodes else None)
     except ImaError as e:
         print(f"ima: recording: {e}", file=sys.stderr)

@@ -83,10 +83,10 @@ class Follow:
 
 
 def feed_until(traces: Iterable[tuple[Path, Callable[[Block], None]]], ended: Callable[[], bool],
-               poll_s: float, wait: Callable[[float], None] = time.sleep) -> None:
+               poll_s: float, pause: Callable[[float], None] = time.sleep) -> None:
     """Follows each (trace, feed) and hands feed its new lines every poll_s until ended() is
     true (the writers have stopped), then what is left, a cut last line included. Between
-    two reads it calls wait(poll_s): a sleep, or a wait that returns as soon as the run ends
+    two reads it calls pause(poll_s): a sleep, or a wait that returns as soon as the run ends
     (the launcher's recorder, whose last reads are on the run's critical path)."""
     follows = [(Follow(path), feed) for path, feed in traces]
     try:
@@ -95,7 +95,7 @@ def feed_until(traces: Iterable[tuple[Path, Callable[[Block], None]]], ended: Ca
                 block = f.new_block()
                 if block:
                     feed(block)
-            wait(poll_s)
+            pause(poll_s)
         for f, feed in follows:
             for block in f.rest():
                 feed(block)

@@ -122,14 +122,14 @@ def _metadata(out: _Out, run_dir: Path, launch: dict) -> None:
 
 
 def record(run_dir: Path, output: Path | None = None, before_verdicts=None,
-           follow=None, nodes: list[str] | None = None, wait=time.sleep) -> dict:
+           follow=None, nodes: list[str] | None = None, pause=time.sleep) -> dict:
     """Writes the recording of run_dir; returns its counts: messages per topic, lines skipped
     (cut by a kill). `before_verdicts()` is called once the traces are in, before the
     summary's verdicts are read (the launcher's recorder waits there for the summary).
 
     With `follow`, the run is still flying: the traces are followed as they grow, every
     POLL_S, until `follow()` says the run's processes have ended (the launcher's recorder:
-    the recording is made on the CPU the lockstep leaves idle); `wait(POLL_S)` passes the time
+    the recording is made on the CPU the lockstep leaves idle); `pause(POLL_S)` passes the time
     between two reads (a sleep; the launcher's recorder returns early when told the run has
     ended); `nodes` then names the run's nodes (launch.json may not exist yet)."""
     run_dir = Path(run_dir)
@@ -145,7 +145,7 @@ def record(run_dir: Path, output: Path | None = None, before_verdicts=None,
             try:
                 if follow is not None:
                     feed_until(topics.traces(run_dir, list(nodes or [])), follow, POLL_S,
-                               wait)
+                               pause)
                 launch = _launch(run_dir)
                 nodes = list(nodes or launch.get("nodes") or sorted(
                     p.stem for p in run_dir.glob("node*.jsonl") if p.stem[4:].isdigit()))

@@ -13,6 +13,9 @@ doing one bad thing at a known release, run for 400 major frames with `./ima run
   identical to a run of the same module in which every rogue behaves (Arguments "none").
 - Two runs write byte-identical traces (emulated time).
 
+A run in which the host stalled a partition that does not spin past its CPU budget is run
+again, once (host_stalls below).
+
 The rogues socket, fork and kill are stopped by the partitions' seccomp sandbox
 (ILLEGAL_REQUEST); without it, kill takes the SKE itself down.
 """
@@ -23,6 +26,7 @@ import json
 import os
 import re
 import subprocess
+import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -171,14 +175,40 @@ def behaving(path: Path) -> str:
     return re.sub(r'(Executable="rogue"\s+Arguments=")[^"]*"', r'\1none"', path.read_text())
 
 
+def host_stalls(run: Run, spinning: set[str]) -> list[dict]:
+    """The CPU-budget overruns of partitions that do not spin. Their windows take a small
+    part of their budgets (the flood some 20 µs of its 1 ms on average, by `ima run --json`'s
+    cpu_ns over its 400 windows): one that still overran was stalled on the host's account (a
+    preempted virtual CPU), as the flight tests' host_stalls says, not by anything under
+    test."""
+    return [e for e in run.events if e["kind"] == "overrun" and e.get("cause") == "cpu_budget"
+            and e.get("partition") not in spinning]
+
+
+def ima_run_unless_host_stalled(module: Path, cwd: Path, spinning: set[str]) -> Run:
+    """ima_run(), once more into a fresh folder if the host stalled a partition that does not
+    spin past its budget (with a warning naming the stall); the second run is judged as is."""
+    run = ima_run(module, cwd)
+    stalls = host_stalls(run, spinning)
+    if stalls:
+        warnings.warn(f"{module.name}: run again, the host stalled a partition past its CPU "
+                      f"budget: {stalls[0]}", stacklevel=2)
+        run = ima_run(module, cwd.with_name(cwd.name + "-again"))
+    return run
+
+
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory) -> dict[str, Run]:
     folder = tmp_path_factory.mktemp("rogues")
     quiet = folder / "behaving.xml"
     quiet.write_text(behaving(MODULE))
-    assert quiet.read_text().count('Arguments="none"') == len(read_tables(MODULE).arguments)
-    return {"rogues": ima_run(MODULE, folder / "a"), "again": ima_run(MODULE, folder / "b"),
-            "behaving": ima_run(quiet, folder / "c")}
+    arguments = read_tables(MODULE).arguments
+    assert quiet.read_text().count('Arguments="none"') == len(arguments)
+    spinning = {name for name, args in arguments.items() if args[0] == "spin"}
+    assert spinning  # the rogue whose overruns the tests judge
+    return {"rogues": ima_run_unless_host_stalled(MODULE, folder / "a", spinning),
+            "again": ima_run_unless_host_stalled(MODULE, folder / "b", spinning),
+            "behaving": ima_run_unless_host_stalled(quiet, folder / "c", spinning)}
 
 
 def describe(run: Run) -> str:

@@ -6,7 +6,7 @@
 #include <inttypes.h>
 #include <stdio.h>
 
-#include "unit_check.h"
+#include "rpas/unit_check.h"
 
 #define CHECK_EQ(a, e)                                                                        \
     do {                                                                                      \
@@ -14,7 +14,7 @@
         if (a_ != e_) {                                                                       \
             fprintf(stderr, "%s:%d: %s == %s: got %jd, expected %jd\n", __FILE__, __LINE__,   \
                     #a, #e, a_, e_);                                                          \
-            failures++;                                                                       \
+            unit_failures++;                                                                  \
         }                                                                                     \
     } while (0)
 

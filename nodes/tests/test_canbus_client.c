@@ -20,7 +20,7 @@
     do {                                                                                      \
         if ((call) != CANBUS_OK) {                                                            \
             fprintf(stderr, "%s:%d: %s failed: %s\n", __FILE__, __LINE__, #call, err);       \
-            failures++;                                                                       \
+            unit_failures++;                                                                  \
             return;                                                                           \
         }                                                                                     \
     } while (0)
@@ -282,8 +282,8 @@ int main(void)
     test_batching_and_the_lockstep();
     unlink(sock);
     rmdir(dir);
-    if (failures) {
-        fprintf(stderr, "%d check(s) failed\n", failures);
+    if (unit_failures) {
+        fprintf(stderr, "%d check(s) failed\n", unit_failures);
         return 1;
     }
     printf("ok   test_canbus_client\n");

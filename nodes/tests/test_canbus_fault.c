@@ -100,7 +100,7 @@ static void test_parse_common_grammar(void)
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
         if (parse(bad[i], &f, name) == 0) {
             fprintf(stderr, "accepted: %s\n", bad[i]);
-            failures++;
+            unit_failures++;
         }
 }
 
@@ -379,9 +379,9 @@ int main(void)
     test_transceiver_cut();
     test_rx_drop();
     test_bus_off_spell_and_babble();
-    if (failures)
-        fprintf(stderr, "test_canbus_fault: %d check(s) failed\n", failures);
+    if (unit_failures)
+        fprintf(stderr, "test_canbus_fault: %d check(s) failed\n", unit_failures);
     else
         printf("test_canbus_fault: ok\n");
-    return failures ? 1 : 0;
+    return unit_failures ? 1 : 0;
 }

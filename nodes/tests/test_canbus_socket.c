@@ -26,7 +26,7 @@ static const char *bus_path;
     do {                                                                                      \
         if (!(cond)) {                                                                        \
             fprintf(stderr, "%s:%d: required: %s\n", __FILE__, __LINE__, #cond);              \
-            failures++;                                                                       \
+            unit_failures++;                                                                  \
             return -1;                                                                        \
         }                                                                                     \
     } while (0)
@@ -701,7 +701,7 @@ static int scenario_admission(const char *dir)
     for (size_t i = 0; i < sizeof stats_has / sizeof *stats_has; i++)
         if (!strstr(text, stats_has[i])) {
             fprintf(stderr, "stats5.json lacks %s\n", stats_has[i]);
-            failures++;
+            unit_failures++;
         }
     CHECK_EQ(count(text, "{\"what\":\"can_client\",\"detail\":"), 9);
     REQUIRE(read_file(trace, text, sizeof text) > 0);
@@ -763,13 +763,13 @@ int main(int argc, char **argv)
     scenario_new_faults(dir);
     scenario_admission(dir);
     scenario_signal(dir);
-    if (!failures) {
+    if (!unit_failures) {
         char cmd[400];
         snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
         if (system(cmd) != 0)
             fprintf(stderr, "could not remove %s\n", dir);
         printf("test_canbus_socket: ok\n");
     } else
-        fprintf(stderr, "test_canbus_socket: %d check(s) failed (files in %s)\n", failures, dir);
-    return failures ? 1 : 0;
+        fprintf(stderr, "test_canbus_socket: %d check(s) failed (files in %s)\n", unit_failures, dir);
+    return unit_failures ? 1 : 0;
 }

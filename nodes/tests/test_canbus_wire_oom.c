@@ -189,8 +189,8 @@ int main(void)
 {
     test_every_allocation_failing_in_turn();
     test_faults_it_refuses();
-    if (failures) {
-        fprintf(stderr, "%d check(s) failed\n", failures);
+    if (unit_failures) {
+        fprintf(stderr, "%d check(s) failed\n", unit_failures);
         return 1;
     }
     printf("ok   test_canbus_wire_oom (%ld allocations failed on purpose)\n", failed);

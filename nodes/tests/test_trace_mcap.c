@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "trace_mcap/trace_mcap.h"
-#include "unit_check.h"
+#include "rpas/unit_check.h"
 
 static const char FRAME[] =
     "{\"t_ns\":480000,\"node\":\"canbus\",\"src\":\"canbus\",\"kind\":\"can_tx\","
@@ -24,7 +24,7 @@ static void check_double(double x, const char *want)
     buf[n] = '\0';
     if (strcmp(buf, want) != 0) {
         fprintf(stderr, "tm_format_double(%.17g): '%s', want '%s'\n", x, buf, want);
-        failures++;
+        unit_failures++;
     }
 }
 
@@ -280,7 +280,7 @@ int main(void)
     test_a_frame();
     test_an_ske_line();
     test_mutated_lines();
-    if (failures)
-        fprintf(stderr, "%d failure(s)\n", failures);
-    return failures ? 1 : 0;
+    if (unit_failures)
+        fprintf(stderr, "%d failure(s)\n", unit_failures);
+    return unit_failures ? 1 : 0;
 }

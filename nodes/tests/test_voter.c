@@ -18,7 +18,7 @@
         if (memcmp(&a_, &e_, sizeof a_) != 0) {                                               \
             fprintf(stderr, "%s:%d: %s is %s: got %a, expected %a\n", __FILE__, __LINE__, #a, \
                     #e, a_, e_);                                                              \
-            failures++;                                                                       \
+            unit_failures++;                                                                  \
         }                                                                                     \
     } while (0)
 
@@ -195,7 +195,7 @@ static void test_truth_table(void)
                             apply_bias(x, (uint8_t)mis, pattern);
                             struct expect e = oracle(n, persist, (uint8_t)present, failed, x);
                             voter_out_t o = step(&v, x, (uint8_t)present);
-                            int before = failures;
+                            int before = unit_failures;
                             for (unsigned d = 0; d < DIM; d++)
                                 CHECK_BITS(o.value[d], e.value[d]);
                             for (unsigned d = DIM; d < VOTER_MAX_DIM; d++)
@@ -212,7 +212,7 @@ static void test_truth_table(void)
                                 if (!(e.failed & (1u << c)))
                                     CHECK_EQ(v.count[c], e.count[c]);
                             }
-                            if (failures != before)
+                            if (unit_failures != before)
                                 fprintf(stderr, "  in case n=%u persist=%u failed=%u "
                                         "present=%u miscompare=%u pattern=%d\n",
                                         n, persist, failed, present, mis, pattern);
@@ -778,8 +778,8 @@ int main(void)
     test_thresholds_per_component();
     test_determinism();
     test_names();
-    if (failures) {
-        fprintf(stderr, "test_voter: %d check(s) failed\n", failures);
+    if (unit_failures) {
+        fprintf(stderr, "test_voter: %d check(s) failed\n", unit_failures);
         return 1;
     }
     printf("test_voter: ok\n");

@@ -13,8 +13,9 @@ doing one bad thing at a known release, run for 400 major frames with `./ima run
   identical to a run of the same module in which every rogue behaves (Arguments "none").
 - Two runs write byte-identical traces (emulated time).
 
-A run in which the host stalled a partition that does not spin past its CPU budget is run
-again, once (host_stalls below).
+A run in which the host stalled a partition that does not spin past its CPU budget (the
+flood, for one, uses some 20 µs of its 1 ms window on average) is run again, once, by the
+flight tests' rule (tests/flight/flight_helpers.py: fly_unless_host_stalled).
 
 The rogues socket, fork and kill are stopped by the partitions' seccomp sandbox
 (ILLEGAL_REQUEST); without it, kill takes the SKE itself down.
@@ -26,17 +27,21 @@ import json
 import os
 import re
 import subprocess
-import warnings
+import sys
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "flight"))  # the flight tests' helpers
+from flight_helpers import fly_unless_host_stalled  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[2]
 MODULE = ROOT / "config" / "examples" / "rogues.xml"
 FRAMES = 400
 HEALTHY = ("producer", "consumer", "monitor")
+NODE = "node1"  # its trace is NODE.jsonl, as a flight's node's (flight_helpers.host_stalls)
 
 # The error each FAULT of rogue.c causes (None: none of its own).
 ROGUE_ERRORS = {
@@ -164,37 +169,16 @@ class Run:
 def ima_run(module: Path, cwd: Path) -> Run:
     cwd.mkdir(parents=True, exist_ok=True)
     p = subprocess.run([str(ROOT / "ima"), "run", str(module), "--frames", str(FRAMES),
-                        "--trace", "r.jsonl"], cwd=cwd, env=dict(os.environ, IMA_SKIP_BUILD="1"),
-                       capture_output=True, text=True, timeout=180)
-    trace = cwd / "r.jsonl"
+                        "--trace", f"{NODE}.jsonl"], cwd=cwd,
+                       env=dict(os.environ, IMA_SKIP_BUILD="1"), capture_output=True, text=True,
+                       timeout=180)
+    trace = cwd / f"{NODE}.jsonl"
     return Run(p.returncode, p.stderr, trace.read_bytes() if trace.exists() else b"")
 
 
 def behaving(path: Path) -> str:
     """The module's text with every rogue's Arguments replaced by "none"."""
     return re.sub(r'(Executable="rogue"\s+Arguments=")[^"]*"', r'\1none"', path.read_text())
-
-
-def host_stalls(run: Run, spinning: set[str]) -> list[dict]:
-    """The CPU-budget overruns of partitions that do not spin. Their windows take a small
-    part of their budgets (the flood some 20 µs of its 1 ms on average, by `ima run --json`'s
-    cpu_ns over its 400 windows): one that still overran was stalled on the host's account (a
-    preempted virtual CPU), as the flight tests' host_stalls says, not by anything under
-    test."""
-    return [e for e in run.events if e["kind"] == "overrun" and e.get("cause") == "cpu_budget"
-            and e.get("partition") not in spinning]
-
-
-def ima_run_unless_host_stalled(module: Path, cwd: Path, spinning: set[str]) -> Run:
-    """ima_run(), once more into a fresh folder if the host stalled a partition that does not
-    spin past its budget (with a warning naming the stall); the second run is judged as is."""
-    run = ima_run(module, cwd)
-    stalls = host_stalls(run, spinning)
-    if stalls:
-        warnings.warn(f"{module.name}: run again, the host stalled a partition past its CPU "
-                      f"budget: {stalls[0]}", stacklevel=2)
-        run = ima_run(module, cwd.with_name(cwd.name + "-again"))
-    return run
 
 
 @pytest.fixture(scope="module")
@@ -204,11 +188,15 @@ def runs(tmp_path_factory) -> dict[str, Run]:
     quiet.write_text(behaving(MODULE))
     arguments = read_tables(MODULE).arguments
     assert quiet.read_text().count('Arguments="none"') == len(arguments)
-    spinning = {name for name, args in arguments.items() if args[0] == "spin"}
-    assert spinning  # the rogue whose overruns the tests judge
-    return {"rogues": ima_run_unless_host_stalled(MODULE, folder / "a", spinning),
-            "again": ima_run_unless_host_stalled(MODULE, folder / "b", spinning),
-            "behaving": ima_run_unless_host_stalled(quiet, folder / "c", spinning)}
+    # the rogue whose overruns the tests judge; any other partition's is the host's
+    spinning = frozenset((NODE, name) for name, args in arguments.items() if args[0] == "spin")
+    assert spinning
+
+    def run(module: Path, cwd: Path) -> Run:
+        return fly_unless_host_stalled(lambda: ima_run(module, cwd), cwd, module.name, spinning)
+
+    return {"rogues": run(MODULE, folder / "a"), "again": run(MODULE, folder / "b"),
+            "behaving": run(quiet, folder / "c")}
 
 
 def describe(run: Run) -> str:

@@ -12,7 +12,7 @@
 #include <string.h>
 
 #include "agent__cipher.h"
-#include "../../tests/unit_check.h"
+#include "rpas/unit_check.h"
 
 #define EVP_CTRL_GCM_GET_TAG 0x10 /* openssl/evp.h */
 #define EVP_CTRL_GCM_SET_TAG 0x11
@@ -208,7 +208,7 @@ int main(void)
     CHECK((*(void **)&g128 = dlsym(lib, "EVP_aes_128_gcm")) != NULL);
     CHECK((*(void **)&g256 = dlsym(lib, "EVP_aes_256_gcm")) != NULL);
     CHECK((*(void **)&cbc = dlsym(lib, "EVP_aes_128_cbc")) != NULL);
-    if (failures)
+    if (unit_failures)
         return 1;
     CHECK((void *)ossl.encrypt_init != (void *)EVP_EncryptInit_ex);
     ossl.gcm[0] = g128();
@@ -220,6 +220,6 @@ int main(void)
     test_the_same_as_openssl();
     test_other_ciphers_pass_as_given();
     printf("test_agent_cipher: %d failures (%" PRIu64 " prefetched, %" PRIu64 " as given)\n",
-           failures, counts().prefetched, counts().as_given);
-    return failures != 0;
+           unit_failures, counts().prefetched, counts().as_given);
+    return unit_failures != 0;
 }

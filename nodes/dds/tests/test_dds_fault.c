@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "agent__fault.h"
-#include "../../tests/unit_check.h"
+#include "rpas/unit_check.h"
 
 #define FRAME_NS 50000000LL
 
@@ -34,7 +34,7 @@ static void test_parse(void)
         CHECK(dds_fault_add(&set, bad[i].spec, err, sizeof err) == -1);
         if (!strstr(err, bad[i].says)) {
             fprintf(stderr, "%s: '%s' does not say '%s'\n", bad[i].spec, err, bad[i].says);
-            failures++;
+            unit_failures++;
         }
     }
     CHECK(set.n == 2);
@@ -99,8 +99,8 @@ int main(void)
     test_parse();
     test_frames_in_a_transient_drop();
     test_intermittent_delay_and_precedence();
-    if (failures) {
-        fprintf(stderr, "test_dds_fault: %d check(s) failed\n", failures);
+    if (unit_failures) {
+        fprintf(stderr, "test_dds_fault: %d check(s) failed\n", unit_failures);
         return 1;
     }
     puts("test_dds_fault: ok");

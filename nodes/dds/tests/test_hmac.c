@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "agent__hmac.h"
-#include "../../tests/unit_check.h"
+#include "rpas/unit_check.h"
 
 typedef unsigned char *hmac_fn(const EVP_MD *md, const void *key, int key_len,
                                const unsigned char *data, size_t data_len, unsigned char *out,
@@ -213,8 +213,8 @@ int main(void)
     test_only_the_same_input_is_reused();
     test_what_is_not_stored();
     test_threads_keep_their_own();
-    if (failures) {
-        fprintf(stderr, "test_agent_hmac: %d check(s) failed\n", failures);
+    if (unit_failures) {
+        fprintf(stderr, "test_agent_hmac: %d check(s) failed\n", unit_failures);
         return 1;
     }
     printf("test_agent_hmac: ok (%" PRIu64 " reused, %" PRIu64 " derived)\n", reused(), derived());

@@ -19,7 +19,7 @@
 #include "ske_abi.h"
 #include "ske_sandbox.h"
 #include "xch/client.h"
-#include "../../tests/unit_check.h"
+#include "rpas/unit_check.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define SANDBOXED 0
@@ -284,7 +284,7 @@ int main(void)
     if (WIFSIGNALED(st)) {
         fprintf(stderr, "the client was killed by signal %d%s\n", WTERMSIG(st),
                 WTERMSIG(st) == SIGSYS ? ": it made a call outside the partition policy" : "");
-        failures++;
+        unit_failures++;
     } else {
         CHECK(WEXITSTATUS(st) == 0);
         if (WEXITSTATUS(st))
@@ -293,8 +293,8 @@ int main(void)
     close(lfd);
     unlink(path);
     rmdir(dir);
-    if (failures) {
-        fprintf(stderr, "test_xch_client: %d check(s) failed\n", failures);
+    if (unit_failures) {
+        fprintf(stderr, "test_xch_client: %d check(s) failed\n", unit_failures);
         return 1;
     }
     printf("test_xch_client: ok%s\n", SANDBOXED ? " (under the io partition's seccomp filter)" : "");

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Minimal assertion helpers of the partitions' unit tests: count failures, print where. */
+/* Minimal assertion helpers of the C unit tests (the partitions', the CAN bus's, the DDS
+ * agent's: nodes/CMakeLists.txt unit_check): count failures, print where. */
 #ifndef RPAS_UNIT_CHECK_H
 #define RPAS_UNIT_CHECK_H
 

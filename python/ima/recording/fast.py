@@ -135,7 +135,9 @@ class _Converter:
             raise MemoryError("trace_mcap: out of memory")
         res = self._res
         if res.out_len:
-            self.out.w.add_records(ctypes.string_at(res.out, res.out_len), self._entries())
+            # the C's buffer, valid until its next call, copied once: into the chunk
+            self.out.w.add_records((ctypes.c_char * res.out_len).from_address(res.out),
+                                   self._entries())
         return rc
 
     def _entries(self) -> list[tuple[int, array]]:

@@ -10,6 +10,7 @@ reader in the tests (tests/recording/)."""
 from __future__ import annotations
 
 import struct
+import sys
 import zlib
 from array import array
 
@@ -20,6 +21,7 @@ OP_METADATA_INDEX, OP_SUMMARY_OFFSET, OP_DATA_END = 13, 14, 15
 
 _MSG = struct.Struct("<BQHIQQ")  # opcode, record length, channel, sequence, log, publish
 _REC = struct.Struct("<BQ")
+_LITTLE = sys.byteorder == "little"
 
 
 def _str(s: str) -> bytes:
@@ -30,6 +32,15 @@ def _str(s: str) -> bytes:
 def _map(d: dict) -> bytes:
     body = b"".join(_str(k) + _str(v) for k, v in d.items())
     return struct.pack("<I", len(body)) + body
+
+
+def _le(a: array) -> bytes:
+    """An array of uint64 as MCAP stores integers: little-endian."""
+    if _LITTLE:
+        return a.tobytes()
+    b = array("Q", a)
+    b.byteswap()
+    return b.tobytes()
 
 
 def _record(op: int, content: bytes) -> bytes:
@@ -66,7 +77,7 @@ class McapWriter:
 
     def _new_chunk(self) -> None:
         self.buf = bytearray()
-        self.index: dict[int, list[int]] = {}  # channel -> [log time, offset, ...]
+        self.index: dict[int, array] = {}  # channel -> [log time, offset, ...] (uint64)
         self.c_min: int | None = None
         self.c_max = 0
 
@@ -96,8 +107,9 @@ class McapWriter:
         buf = self.buf
         idx = self.index.get(cid)
         if idx is None:
-            idx = self.index[cid] = []
-        idx += (t, len(buf))
+            idx = self.index[cid] = array("Q")
+        idx.append(t)
+        idx.append(len(buf))
         buf += _MSG.pack(OP_MESSAGE, 22 + len(data), cid, seq & 0xFFFFFFFF, t, t)
         buf += data
         if len(buf) >= self.chunk_bytes:
@@ -107,15 +119,16 @@ class McapWriter:
         """Bytes of the chunk being built: where the next record goes."""
         return len(self.buf)
 
-    def add_records(self, data: bytes, entries: list[tuple[int, array]]) -> None:
-        """Message records made elsewhere (recording/fast.py), with each channel's index
-        entries (log time, offset in the chunk; the channels in the order of their first
-        record); the chunk is written if full, as after message()."""
+    def add_records(self, data, entries: list[tuple[int, array]]) -> None:
+        """Message records made elsewhere (recording/fast.py; any bytes-like object, copied
+        here), with each channel's index entries (log time, offset in the chunk, as an
+        array of uint64; the channels in the order of their first record); the chunk is
+        written if full, as after message()."""
         self.buf += data
         for cid, pairs in entries:
             idx = self.index.get(cid)
             if idx is None:
-                idx = self.index[cid] = []
+                idx = self.index[cid] = array("Q")
             idx += pairs
         if len(self.buf) >= self.chunk_bytes:
             self._flush_chunk()
@@ -130,7 +143,7 @@ class McapWriter:
             self.c_min = lo if self.c_min is None else min(self.c_min, lo)
             self.c_max = max(self.c_max, hi)
             self.counts[cid] += len(times)
-        raw = bytes(self.buf)
+        raw = self.buf  # a new one follows (_new_chunk): no copy
         comp = self.zstd.compress(raw)
         start = self.pos
         body = (struct.pack("<QQQI", self.c_min, self.c_max, len(raw), zlib.crc32(raw))
@@ -140,7 +153,7 @@ class McapWriter:
         offsets = {}
         for cid, entries in self.index.items():
             offsets[cid] = self.pos
-            pairs = struct.pack(f"<{len(entries)}Q", *entries)
+            pairs = _le(entries)
             self._write(_record(OP_MESSAGE_INDEX, struct.pack("<HI", cid, len(pairs)) + pairs))
         index_len = self.pos - start - chunk_len
         off_body = b"".join(struct.pack("<HQ", c, o) for c, o in offsets.items())

@@ -110,6 +110,12 @@ def test_the_dbc_cache_gives_the_same_codecs_and_follows_the_file(tmp_path, monk
     assert json.loads(cache.read_text())["layout"] == dbc_table.LAYOUT
 
 
+def test_the_cache_key_has_the_version_of_cantools_that_importlib_metadata_gives():
+    from importlib import metadata
+
+    assert dbc_table._cantools_version() == metadata.version("cantools")
+
+
 def test_a_signal_the_fast_codec_cannot_decode_is_refused_by_it_not_by_the_table(tmp_path,
                                                                                   monkeypatch):
     """The deployment reads any DBC's messages through the cache; the fast codec refuses a

@@ -520,3 +520,16 @@ size_t tm_entries(const tm_conv_t *c, uint16_t cid, const uint64_t **pairs)
     *pairs = NULL;
     return 0;
 }
+
+uint64_t tm_count_lines(const uint8_t *text, size_t len)
+{
+    uint64_t n = 0;
+    const uint8_t *end = text + len;
+    for (const uint8_t *p = text; p < end; n++) {
+        p = memchr(p, '\n', (size_t)(end - p));
+        if (!p)
+            break;
+        p++;
+    }
+    return n;
+}

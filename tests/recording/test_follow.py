@@ -6,6 +6,7 @@ ended, not after the rest of a poll's sleep."""
 from __future__ import annotations
 
 import os
+import random
 import time
 
 from ima.recording import follow
@@ -53,3 +54,26 @@ def test_the_recorder_wait_returns_when_the_launcher_says_ended(monkeypatch):
         if w >= 0:
             os.close(w)
         os.close(r)
+
+
+def test_lines_are_counted_by_the_c_as_bytes_count_counts_them(tmp_path):
+    """The blocks' line numbers come from the C's count (recording/fast.py, line_counter)."""
+    from ima.recording import fast
+
+    assert fast.library() is not None, f"{fast.library_path()} is not built"
+    count = fast.line_counter()
+    rng = random.Random(7)
+    cases = [b"", b"x", b"\n", b"\n\n", b"a\nb", b"a\nb\n", b"\0\n\0\xff\n"]
+    cases += [bytes(rng.choice(b"ab\n\0") for _ in range(rng.randrange(1, 300)))
+              for _ in range(200)]
+    for data in cases:
+        assert count(data) == data.count(b"\n"), data
+    # and a trace followed block by block: each block numbered from the lines before it
+    trace = tmp_path / "t.jsonl"
+    trace.write_bytes(b"".join(b'{"i":%d}\n' % i for i in range(1000)))
+    f = follow.Follow(trace)
+    firsts = [(b.first, b.data.count(b"\n")) for b in f.blocks(777)]
+    f.close()
+    assert [first for first, _ in firsts] == \
+        [sum(n for _, n in firsts[:k]) + firsts[0][0] for k in range(len(firsts))]
+    assert sum(n for _, n in firsts) == 1000

@@ -66,6 +66,10 @@ int tm_convert(tm_conv_t *c, const uint8_t *text, size_t len, uint64_t seq, uint
 size_t tm_channels(const tm_conv_t *c, const uint16_t **cids);
 size_t tm_entries(const tm_conv_t *c, uint16_t cid, const uint64_t **pairs);
 
+/* How many lines end in text[0..len): its '\n' bytes (the recorder numbers a trace's lines by
+ * them; Python's bytes.count scans a byte at a time, glibc's memchr a vector at a time). */
+uint64_t tm_count_lines(const uint8_t *text, size_t len);
+
 /* A flight data recorder file's records (TM_FDR converter; partitions/fdr/fdr.h: fixed
  * 320-byte records, each a header, a body and a CRC-32): of the file's `n` whole records at
  * `data`, those from record `from` on, the first good one numbered `seq`, as messages of the

@@ -83,9 +83,20 @@ def _declare(lib: ctypes.CDLL) -> None:
                                         c.POINTER(c.POINTER(c.c_uint64))]),
             ("tm_fdr", c.c_int, [c.c_void_p, c.c_void_p, c.c_size_t, c.c_size_t, c.c_uint64,
                                  c.c_uint64, c.c_uint64, c.POINTER(_Result)]),
-            ("tm_format_double", c.c_size_t, [c.c_double, c.c_char_p])):
+            ("tm_format_double", c.c_size_t, [c.c_double, c.c_char_p]),
+            ("tm_count_lines", c.c_uint64, [c.c_char_p, c.c_size_t])):
         f = getattr(lib, name)
         f.restype, f.argtypes = res, args
+
+
+def line_counter() -> Callable[[bytes], int]:
+    """How many lines end in a block (its newline bytes): the C's count where the library is
+    built (some ten times faster than bytes.count), else bytes.count."""
+    lib = library()
+    if lib is None:
+        return lambda data: data.count(b"\n")
+    count = lib.tm_count_lines
+    return lambda data: count(data, len(data))
 
 
 class _Converter:

@@ -15,6 +15,19 @@ from pathlib import Path
 from typing import NamedTuple
 
 
+_count: Callable[[bytes], int] | None = None
+
+
+def count_lines(data: bytes) -> int:
+    """How many lines end in `data` (recording/fast.py's line_counter, looked up once)."""
+    global _count
+    if _count is None:
+        from ima.recording.fast import line_counter  # it imports this module
+
+        _count = line_counter()
+    return _count(data)
+
+
 class Block(NamedTuple):
     first: int  # the number of the first line
     data: bytes
@@ -63,7 +76,7 @@ class Follow:
         if not end:
             return None
         block = Block(self._next, data[:end])
-        self._next += block.data.count(b"\n")
+        self._next += count_lines(block.data)
         return block
 
     def rest(self) -> list[Block]:

@@ -37,41 +37,119 @@ int ske_trace_close(ske_trace_t *t)
     return rc;
 }
 
-void ske_json_escape(FILE *f, const char *s, size_t len)
+/* A piece of a line built in memory, then written with one call: fprintf's format parsing
+ * and a call per character cost more than the rest of a window's bookkeeping. */
+typedef struct {
+    char b[256];
+    size_t n;
+} piece_t;
+
+static void piece_flush(piece_t *p, FILE *f)
 {
-    fputc('"', f);
+    if (p->n)
+        fwrite(p->b, 1, p->n, f);
+    p->n = 0;
+}
+
+static void piece_put(piece_t *p, FILE *f, const char *s, size_t n)
+{
+    if (p->n + n > sizeof p->b) {
+        piece_flush(p, f);
+        if (n > sizeof p->b) {
+            fwrite(s, 1, n, f);
+            return;
+        }
+    }
+    memcpy(p->b + p->n, s, n);
+    p->n += n;
+}
+
+static void piece_str(piece_t *p, FILE *f, const char *s)
+{
+    piece_put(p, f, s, strlen(s));
+}
+
+static void piece_i64(piece_t *p, FILE *f, int64_t v)
+{
+    char d[24], *e = d + sizeof d, *q = e;
+    uint64_t u = v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
+    do {
+        *--q = (char)('0' + u % 10);
+        u /= 10;
+    } while (u);
+    if (v < 0)
+        *--q = '-';
+    piece_put(p, f, q, (size_t)(e - q));
+}
+
+/* ,"key": (keys are the SKE's own names: not escaped) */
+static void piece_key(piece_t *p, FILE *f, const char *key)
+{
+    piece_put(p, f, ",\"", 2);
+    piece_str(p, f, key);
+    piece_put(p, f, "\":", 2);
+}
+
+static void piece_escaped(piece_t *p, FILE *f, const char *s, size_t len)
+{
+    piece_put(p, f, "\"", 1);
+    size_t from = 0;
     for (size_t i = 0; i < len; i++) {
         unsigned char c = (unsigned char)s[i];
-        if (c == '"' || c == '\\')
-            fprintf(f, "\\%c", c);
-        else if (c == '\n')
-            fputs("\\n", f);
-        else if (c < 0x20 || c >= 0x7f)
-            fprintf(f, "\\u%04x", c); /* bytes, not UTF-8: keep the line valid JSON */
-        else
-            fputc(c, f);
+        if (c != '"' && c != '\\' && c >= 0x20 && c < 0x7f)
+            continue;
+        piece_put(p, f, s + from, i - from);
+        from = i + 1;
+        char e[8];
+        if (c == '"' || c == '\\') {
+            e[0] = '\\';
+            e[1] = (char)c;
+            piece_put(p, f, e, 2);
+        } else if (c == '\n') {
+            piece_put(p, f, "\\n", 2);
+        } else { /* bytes, not UTF-8: keep the line valid JSON */
+            static const char hex[] = "0123456789abcdef";
+            memcpy(e, "\\u00", 4);
+            e[4] = hex[c >> 4];
+            e[5] = hex[c & 15];
+            piece_put(p, f, e, 6);
+        }
     }
-    fputc('"', f);
+    piece_put(p, f, s + from, len - from);
+    piece_put(p, f, "\"", 1);
+}
+
+void ske_json_escape(FILE *f, const char *s, size_t len)
+{
+    piece_t p = {.n = 0};
+    piece_escaped(&p, f, s, len);
+    piece_flush(&p, f);
 }
 
 void ske_trace_begin(ske_trace_t *t, int64_t t_ns, const char *src, const char *kind)
 {
     if (!t->f)
         return;
-    fprintf(t->f, "{\"t_ns\":%" PRId64 ",\"node\":", t_ns);
-    ske_json_escape(t->f, t->node, strlen(t->node));
-    fputs(",\"src\":", t->f);
-    ske_json_escape(t->f, src, strlen(src));
-    fputs(",\"kind\":", t->f);
-    ske_json_escape(t->f, kind, strlen(kind));
+    piece_t p = {.n = 0};
+    piece_put(&p, t->f, "{\"t_ns\":", 8);
+    piece_i64(&p, t->f, t_ns);
+    piece_put(&p, t->f, ",\"node\":", 8);
+    piece_escaped(&p, t->f, t->node, strlen(t->node));
+    piece_put(&p, t->f, ",\"src\":", 7);
+    piece_escaped(&p, t->f, src, strlen(src));
+    piece_put(&p, t->f, ",\"kind\":", 8);
+    piece_escaped(&p, t->f, kind, strlen(kind));
+    piece_flush(&p, t->f);
 }
 
 void ske_trace_strn(ske_trace_t *t, const char *key, const char *val, size_t len)
 {
     if (!t->f)
         return;
-    fprintf(t->f, ",\"%s\":", key);
-    ske_json_escape(t->f, val, len);
+    piece_t p = {.n = 0};
+    piece_key(&p, t->f, key);
+    piece_escaped(&p, t->f, val, len);
+    piece_flush(&p, t->f);
 }
 
 void ske_trace_str(ske_trace_t *t, const char *key, const char *val)
@@ -81,26 +159,38 @@ void ske_trace_str(ske_trace_t *t, const char *key, const char *val)
 
 void ske_trace_int(ske_trace_t *t, const char *key, int64_t v)
 {
-    if (t->f)
-        fprintf(t->f, ",\"%s\":%" PRId64, key, v);
+    if (!t->f)
+        return;
+    piece_t p = {.n = 0};
+    piece_key(&p, t->f, key);
+    piece_i64(&p, t->f, v);
+    piece_flush(&p, t->f);
 }
 
 void ske_trace_bool(ske_trace_t *t, const char *key, bool v)
 {
-    if (t->f)
-        fprintf(t->f, ",\"%s\":%s", key, v ? "true" : "false");
+    if (!t->f)
+        return;
+    piece_t p = {.n = 0};
+    piece_key(&p, t->f, key);
+    piece_str(&p, t->f, v ? "true" : "false");
+    piece_flush(&p, t->f);
 }
 
 void ske_trace_raw(ske_trace_t *t, const char *key, const char *json)
 {
-    if (t->f)
-        fprintf(t->f, ",\"%s\":%s", key, json);
+    if (!t->f)
+        return;
+    piece_t p = {.n = 0};
+    piece_key(&p, t->f, key);
+    piece_str(&p, t->f, json);
+    piece_flush(&p, t->f);
 }
 
 void ske_trace_end(ske_trace_t *t)
 {
     if (t->f)
-        fputs("}\n", t->f);
+        fwrite("}\n", 1, 2, t->f);
 }
 
 void ske_trace_maybe_flush(ske_trace_t *t, int64_t mono_ns)

@@ -67,7 +67,7 @@ SANITIZED_TARGETS = ("test_config", "test_port_buf", "test_plan", "test_hm", "te
                      "nav_fcs_test_nf_math", "nav_fcs_test_nav", "nav_fcs_test_fcs",
                      "io_test_settings", "io_test_can_rx", "io_test_can_tx", "io_test_redundancy",
                      "test_fi_spec", "test_voter", "test_canbus_fault", "test_fi_wrong_output",
-                     "test_dds_fault", "test_agent_hmac", "test_agent_cipher",
+                     "test_dds_fault", "test_agent_hmac", "test_agent_cipher", "test_trace",
                      "fdr_test_fdr")
 # Built with them because a sanitized test runs it.
 SANITIZED_HELPERS = ("ima-canbus",)

@@ -4,6 +4,8 @@
 
 #include <string.h>
 
+#include "rpas/crc32.h"
+
 void fdr_init(fdr_t *f, int64_t major_frame_ns)
 {
     f->seq = 0;
@@ -12,14 +14,7 @@ void fdr_init(fdr_t *f, int64_t major_frame_ns)
 
 uint32_t fdr_crc32(const void *data, size_t len)
 {
-    const uint8_t *b = data;
-    uint32_t c = 0xffffffffu;
-    for (size_t i = 0; i < len; i++) {
-        c ^= b[i];
-        for (int k = 0; k < 8; k++)
-            c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
-    }
-    return ~c;
+    return rpas_crc32(data, len);
 }
 
 static void seal(fdr_t *f, uint16_t kind, int64_t t_ns, const void *body, uint32_t len,

@@ -12,6 +12,34 @@ static void test_crc_matches_the_ieee_check_value(void)
     CHECK(fdr_crc32("", 0) == 0);
 }
 
+/* The table-driven CRC (rpas/crc32.h) against its definition, a bit at a time. */
+static uint32_t crc_by_bits(const uint8_t *b, size_t len)
+{
+    uint32_t c = 0xffffffffu;
+    for (size_t i = 0; i < len; i++) {
+        c ^= b[i];
+        for (int k = 0; k < 8; k++)
+            c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+    }
+    return ~c;
+}
+
+static void test_crc_matches_its_definition(void)
+{
+    uint8_t buf[FDR_RECORD_SIZE];
+    uint32_t x = 12345;
+    for (size_t i = 0; i < sizeof buf; i++) {
+        x = x * 1103515245u + 12345u;
+        buf[i] = (uint8_t)(x >> 16);
+    }
+    for (size_t n = 0; n <= sizeof buf; n += 7)
+        CHECK(fdr_crc32(buf, n) == crc_by_bits(buf, n));
+    for (int v = 0; v < 256; v++) {
+        uint8_t one = (uint8_t)v;
+        CHECK(fdr_crc32(&one, 1) == crc_by_bits(&one, 1));
+    }
+}
+
 static void test_records_are_numbered_and_check(void)
 {
     fdr_t f;
@@ -64,6 +92,7 @@ static void test_torn_and_foreign_records_are_refused(void)
 int main(void)
 {
     RUN(test_crc_matches_the_ieee_check_value);
+    RUN(test_crc_matches_its_definition);
     RUN(test_records_are_numbered_and_check);
     RUN(test_torn_and_foreign_records_are_refused);
     return UNIT_RESULT();

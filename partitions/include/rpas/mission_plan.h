@@ -18,6 +18,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "crc32.h" /* rpas_crc32: the uplink's check */
+
 #define RPAS_PLAN_MAGIC 0x4E4C504Du /* "MPLN" as little-endian bytes */
 #define RPAS_PLAN_VERSION 1
 #define RPAS_PLAN_MAX_LEGS 48
@@ -130,18 +132,5 @@ typedef struct {
 _Static_assert(sizeof(rpas_plan_leg_t) == 48, "a leg is 48 bytes");
 _Static_assert(sizeof(rpas_plan_contingency_t) == 24, "a contingency is 24 bytes");
 _Static_assert(sizeof(rpas_plan_header_t) == 200, "the header is 200 bytes");
-
-/* CRC-32 (IEEE 802.3, reflected, as zlib's crc32) of a byte string: the uplink's check. */
-static inline uint32_t rpas_crc32(const void *data, size_t len)
-{
-    const uint8_t *p = (const uint8_t *)data;
-    uint32_t crc = 0xFFFFFFFFu;
-    for (size_t i = 0; i < len; i++) {
-        crc ^= p[i];
-        for (int k = 0; k < 8; k++)
-            crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
-    }
-    return ~crc;
-}
 
 #endif

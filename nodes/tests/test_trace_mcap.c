@@ -273,8 +273,32 @@ static void test_fdr_records(void)
     tm_free(c);
 }
 
+/* tm_count_lines against a count a byte at a time, on random text of newlines and NULs and
+ * on every length and offset around memchr's vector widths. */
+static void test_count_lines(void)
+{
+    CHECK(tm_count_lines((const uint8_t *)"", 0) == 0);
+    CHECK(tm_count_lines((const uint8_t *)"\n", 1) == 1);
+    CHECK(tm_count_lines((const uint8_t *)"a\nb", 3) == 1);
+    uint8_t buf[300];
+    unsigned x = 7;
+    for (int round = 0; round < 200; round++) {
+        for (size_t i = 0; i < sizeof buf; i++) {
+            x = x * 1103515245u + 12345u;
+            unsigned v = (x >> 16) % 5;
+            buf[i] = v == 0 ? '\n' : v == 1 ? 0 : (uint8_t)('a' + v);
+        }
+        size_t from = (size_t)round % 70, len = sizeof buf - from - (size_t)round % 33;
+        uint64_t want = 0;
+        for (size_t i = from; i < from + len; i++)
+            want += buf[i] == '\n';
+        CHECK(tm_count_lines(buf + from, len) == want);
+    }
+}
+
 int main(void)
 {
+    test_count_lines();
     test_fdr_records();
     test_numbers();
     test_a_frame();

@@ -3,7 +3,6 @@
 #include "ske__trace.h"
 
 #include <errno.h>
-#include <inttypes.h>
 #include <string.h>
 
 int ske_trace_open(ske_trace_t *t, const char *path, const char *node)
@@ -64,6 +63,9 @@ static void piece_put(piece_t *p, FILE *f, const char *s, size_t n)
     p->n += n;
 }
 
+/* A string literal, its length from its size. */
+#define PIECE_LIT(p, f, lit) piece_put((p), (f), (lit), sizeof(lit) - 1)
+
 static void piece_str(piece_t *p, FILE *f, const char *s)
 {
     piece_put(p, f, s, strlen(s));
@@ -85,14 +87,14 @@ static void piece_i64(piece_t *p, FILE *f, int64_t v)
 /* ,"key": (keys are the SKE's own names: not escaped) */
 static void piece_key(piece_t *p, FILE *f, const char *key)
 {
-    piece_put(p, f, ",\"", 2);
+    PIECE_LIT(p, f, ",\"");
     piece_str(p, f, key);
-    piece_put(p, f, "\":", 2);
+    PIECE_LIT(p, f, "\":");
 }
 
 static void piece_escaped(piece_t *p, FILE *f, const char *s, size_t len)
 {
-    piece_put(p, f, "\"", 1);
+    PIECE_LIT(p, f, "\"");
     size_t from = 0;
     for (size_t i = 0; i < len; i++) {
         unsigned char c = (unsigned char)s[i];
@@ -106,7 +108,7 @@ static void piece_escaped(piece_t *p, FILE *f, const char *s, size_t len)
             e[1] = (char)c;
             piece_put(p, f, e, 2);
         } else if (c == '\n') {
-            piece_put(p, f, "\\n", 2);
+            PIECE_LIT(p, f, "\\n");
         } else { /* bytes, not UTF-8: keep the line valid JSON */
             static const char hex[] = "0123456789abcdef";
             memcpy(e, "\\u00", 4);
@@ -116,7 +118,7 @@ static void piece_escaped(piece_t *p, FILE *f, const char *s, size_t len)
         }
     }
     piece_put(p, f, s + from, len - from);
-    piece_put(p, f, "\"", 1);
+    PIECE_LIT(p, f, "\"");
 }
 
 void ske_json_escape(FILE *f, const char *s, size_t len)
@@ -131,13 +133,13 @@ void ske_trace_begin(ske_trace_t *t, int64_t t_ns, const char *src, const char *
     if (!t->f)
         return;
     piece_t p = {.n = 0};
-    piece_put(&p, t->f, "{\"t_ns\":", 8);
+    PIECE_LIT(&p, t->f, "{\"t_ns\":");
     piece_i64(&p, t->f, t_ns);
-    piece_put(&p, t->f, ",\"node\":", 8);
+    PIECE_LIT(&p, t->f, ",\"node\":");
     piece_escaped(&p, t->f, t->node, strlen(t->node));
-    piece_put(&p, t->f, ",\"src\":", 7);
+    PIECE_LIT(&p, t->f, ",\"src\":");
     piece_escaped(&p, t->f, src, strlen(src));
-    piece_put(&p, t->f, ",\"kind\":", 8);
+    PIECE_LIT(&p, t->f, ",\"kind\":");
     piece_escaped(&p, t->f, kind, strlen(kind));
     piece_flush(&p, t->f);
 }

@@ -110,10 +110,17 @@ def test_the_dbc_cache_gives_the_same_codecs_and_follows_the_file(tmp_path, monk
     assert json.loads(cache.read_text())["layout"] == dbc_table.LAYOUT
 
 
-def test_the_cache_key_has_the_version_of_cantools_that_importlib_metadata_gives():
+def test_the_cache_key_has_the_version_of_cantools_that_importlib_metadata_gives(monkeypatch):
     from importlib import metadata
 
-    assert dbc_table._cantools_version() == metadata.version("cantools")
+    version = metadata.version("cantools")
+    assert dbc_table._cantools_version() == version
+
+    def refuse(name):  # the version comes from the distribution's directory name
+        raise AssertionError(f"importlib.metadata asked for {name}")
+
+    monkeypatch.setattr(metadata, "version", refuse)
+    assert dbc_table._cantools_version() == version
 
 
 def test_a_signal_the_fast_codec_cannot_decode_is_refused_by_it_not_by_the_table(tmp_path,

@@ -56,7 +56,7 @@ def _write(chunk_bytes: int) -> tuple[bytes, list[tuple[int, int, bytes]]]:
 
 
 def test_message_indexes_point_at_their_messages():
-    for chunk_bytes in (1 << 20, 700):  # one chunk, and many (some ending inside a block)
+    for chunk_bytes in (1 << 20, 700):  # one chunk, and many (some full after a block)
         data, sent = _write(chunk_bytes)
         chunks, got = 0, []
         pending: list[bytes] = []
@@ -75,4 +75,4 @@ def test_message_indexes_point_at_their_messages():
         # every message once, each where its index says, in the order written
         got.sort(key=lambda g: (g[1], g[0]))
         assert [(cid, t, p) for _o, _c, cid, t, p in got] == sent
-        assert chunks == 1 if chunk_bytes > len(data) else chunks > 3
+        assert (chunks == 1) if chunk_bytes > len(data) else (chunks > 3)

@@ -44,7 +44,7 @@ def _read(path: Path) -> list[dict]:
 def _cantools_version() -> str:
     """The installed cantools's version, from its distribution's directory name where there is
     exactly one beside the package (importlib.metadata, which scans every distribution and
-    imports the email package, costs some 20 ms of CPU in each process of a run); else from
+    imports the email package, costs some 20–30 ms of CPU in each process of a run); else from
     importlib.metadata; "?" without cantools."""
     import importlib.util
 

@@ -89,6 +89,17 @@ def _declare(lib: ctypes.CDLL) -> None:
         f.restype, f.argtypes = res, args
 
 
+_memory = ctypes.pythonapi.PyMemoryView_FromMemory
+_memory.restype, _memory.argtypes = ctypes.py_object, [ctypes.c_void_p, ctypes.c_ssize_t,
+                                                       ctypes.c_int]
+_PYBUF_READ = 0x100
+
+
+def _view(address: int, n: int) -> memoryview:
+    """A read-only view of n bytes of the C's memory (no copy, no ctypes type per length)."""
+    return _memory(address, n, _PYBUF_READ)
+
+
 def line_counter() -> Callable[[bytes], int]:
     """How many lines end in a block (its newline bytes): the C's count where the library is
     built (some ten times faster than bytes.count), else bytes.count."""
@@ -146,9 +157,10 @@ class _Converter:
             raise MemoryError("trace_mcap: out of memory")
         res = self._res
         if res.out_len:
-            # the C's buffer, valid until its next call, copied once: into the chunk
-            self.out.w.add_records((ctypes.c_char * res.out_len).from_address(res.out),
-                                   self._entries())
+            entries = self._entries()
+            # the C's buffer, valid until its next conversion, read in place and copied once:
+            # into the chunk
+            self.out.w.add_records(_view(res.out, res.out_len), entries)
         return rc
 
     def _entries(self) -> list[tuple[int, array]]:

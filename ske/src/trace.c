@@ -169,16 +169,6 @@ void ske_trace_int(ske_trace_t *t, const char *key, int64_t v)
     piece_flush(&p, t->f);
 }
 
-void ske_trace_bool(ske_trace_t *t, const char *key, bool v)
-{
-    if (!t->f)
-        return;
-    piece_t p = {.n = 0};
-    piece_key(&p, t->f, key);
-    piece_str(&p, t->f, v ? "true" : "false");
-    piece_flush(&p, t->f);
-}
-
 void ske_trace_raw(ske_trace_t *t, const char *key, const char *json)
 {
     if (!t->f)
@@ -187,6 +177,11 @@ void ske_trace_raw(ske_trace_t *t, const char *key, const char *json)
     piece_key(&p, t->f, key);
     piece_str(&p, t->f, json);
     piece_flush(&p, t->f);
+}
+
+void ske_trace_bool(ske_trace_t *t, const char *key, bool v)
+{
+    ske_trace_raw(t, key, v ? "true" : "false");
 }
 
 void ske_trace_end(ske_trace_t *t)

@@ -68,7 +68,7 @@ SANITIZED_TARGETS = ("test_config", "test_port_buf", "test_plan", "test_hm", "te
                      "io_test_settings", "io_test_can_rx", "io_test_can_tx", "io_test_redundancy",
                      "test_fi_spec", "test_voter", "test_canbus_fault", "test_fi_wrong_output",
                      "test_dds_fault", "test_agent_hmac", "test_agent_cipher", "test_trace",
-                     "fdr_test_fdr")
+                     "fdr_test_fdr", "test_trace_mcap", "mission_manager_test_mm")
 # Built with them because a sanitized test runs it.
 SANITIZED_HELPERS = ("ima-canbus",)
 
